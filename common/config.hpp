@@ -1,0 +1,128 @@
+// Configuration from YAML into plain structs whose defaults are written in the struct.
+//
+// A config struct lists its keys once, in a `visit` member:
+//
+//   struct MatcherConfig {
+//     double resolution_m = 0.05;
+//     int levels = 3;
+//     template <class V> void visit(V& v) { v("resolution_m", resolution_m); v("levels", levels); }
+//   };
+//
+// Members may be bool, integers, double, std::string, std::vector of those, or nested structs
+// with their own `visit`. Loading fails with a ConfigError naming the file and the full key path
+// when a key is unknown, has the wrong type, or the file is missing or not YAML. Keys absent from
+// the file keep their defaults.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace traverse {
+
+// Exit code of every program when its configuration is bad.
+inline constexpr int kConfigErrorExitCode = 2;
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+namespace config_detail {
+
+template <class T>
+struct is_vector : std::false_type {};
+template <class T>
+struct is_vector<std::vector<T>> : std::true_type {};
+
+std::string type_name_of(const YAML::Node& n);
+
+class Reader {
+ public:
+  Reader(const YAML::Node& node, std::string file, std::string prefix)
+      : node_(node), file_(std::move(file)), prefix_(std::move(prefix)) {
+    check_is_mapping();
+  }
+
+  // Called by the struct's visit(): reads one key if present.
+  template <class T>
+  void operator()(const char* key, T& value) {
+    used_.push_back(key);
+    const YAML::Node& node = node_;  // const: a look-up must not add the key
+    const YAML::Node child = node[key];
+    if (!child) return;
+    read(child, prefix_ + key, value);
+  }
+
+  // After visit(): every key in the file must have been used.
+  void check_unknown_keys() const;
+
+ private:
+  template <class T>
+  void read(const YAML::Node& n, const std::string& path, T& value) {
+    if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string> && !is_vector<T>::value) {
+      if (!n.IsMap()) fail(path, "a mapping of keys", n);
+      Reader nested(n, file_, path + ".");
+      value.visit(nested);
+      nested.check_unknown_keys();
+    } else if constexpr (is_vector<T>::value) {
+      if (!n.IsSequence()) fail(path, "a list", n);
+      T out;
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        typename T::value_type item{};
+        read(n[i], path + "[" + std::to_string(i) + "]", item);
+        out.push_back(std::move(item));
+      }
+      value = std::move(out);
+    } else {
+      if (!n.IsScalar()) fail(path, expected_name<T>(), n);
+      try {
+        value = n.as<T>();
+      } catch (const YAML::Exception&) {
+        fail(path, expected_name<T>(), n);
+      }
+    }
+  }
+
+  template <class T>
+  static const char* expected_name() {
+    if constexpr (std::is_same_v<T, bool>) return "true or false";
+    else if constexpr (std::is_integral_v<T>) return "an integer";
+    else if constexpr (std::is_floating_point_v<T>) return "a number";
+    else return "a string";
+  }
+
+  void check_is_mapping() const;
+  [[noreturn]] void fail(const std::string& path, const char* expected, const YAML::Node& got) const;
+
+  YAML::Node node_;
+  std::string file_;
+  std::string prefix_;
+  std::vector<std::string> used_;
+};
+
+YAML::Node load_file(const std::string& path);
+YAML::Node load_string(const std::string& text, const std::string& name);
+
+}  // namespace config_detail
+
+// Loads `path` into `config`, throwing ConfigError (naming the key and the file) on any problem.
+template <class Config>
+void load_config(const std::string& path, Config& config) {
+  config_detail::Reader reader(config_detail::load_file(path), path, "");
+  config.visit(reader);
+  reader.check_unknown_keys();
+}
+
+// Same from YAML text; `name` stands in for the file name in errors (tests, embedded defaults).
+template <class Config>
+void load_config_text(const std::string& text, const std::string& name, Config& config) {
+  config_detail::Reader reader(config_detail::load_string(text, name), name, "");
+  config.visit(reader);
+  reader.check_unknown_keys();
+}
+
+}  // namespace traverse

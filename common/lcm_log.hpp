@@ -1,0 +1,55 @@
+// Reads LCM log files event by event, and says exactly where and how a damaged file is damaged.
+//
+// The format (LCM's eventlog): each event is a big-endian header -- sync word 0xEDA1DA01,
+// int64 event number, int64 timestamp [us], int32 channel length, int32 data length -- followed
+// by the channel name and the data. lcm::LogFile stops silently at damage; this reader reports
+// the byte offset, then looks for the next sync word so that everything readable is still read.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace traverse {
+
+struct LogEvent {
+  int64_t event_number = 0;
+  int64_t utime = 0;             // [us] event timestamp (receive time, or message time)
+  std::string channel;
+  std::vector<uint8_t> data;
+  uint64_t offset = 0;           // [bytes] where the event's header starts in the file
+};
+
+struct LogDamage {
+  uint64_t offset = 0;           // [bytes] where the damaged record starts
+  std::string what;              // e.g. "truncated record", "bad sync word"
+  uint64_t skipped_bytes = 0;    // [bytes] skipped until the next readable event (or the end)
+};
+
+class LogReader {
+ public:
+  explicit LogReader(const std::string& path);  // throws std::runtime_error if it cannot open
+  ~LogReader();
+  LogReader(const LogReader&) = delete;
+  LogReader& operator=(const LogReader&) = delete;
+
+  // Next intact event, or nullopt at the end of the file. Damage met on the way is recorded.
+  std::optional<LogEvent> next();
+
+  const std::vector<LogDamage>& damage() const { return damage_; }
+  uint64_t file_size() const { return file_size_; }
+
+ private:
+  // Reads an event at the current position; nullopt and records damage if it is not intact.
+  std::optional<LogEvent> read_at(uint64_t offset, std::string& problem);
+  bool resync(uint64_t from);  // moves to the next sync word after `from`; false at end
+
+  std::vector<LogDamage> damage_;
+  std::FILE* file_ = nullptr;
+  uint64_t file_size_ = 0;
+  uint64_t pos_ = 0;
+};
+
+}  // namespace traverse

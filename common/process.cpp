@@ -1,0 +1,151 @@
+#include "process.hpp"
+
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+
+#include <spdlog/spdlog.h>
+
+#include "channels.hpp"
+#include "traverse/process_status_t.hpp"
+
+namespace traverse {
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+void on_stop_signal(int) { g_stop = true; }
+
+double cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+int64_t resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  int64_t size_pages = 0, resident_pages = 0;
+  statm >> size_pages >> resident_pages;
+  return resident_pages * sysconf(_SC_PAGESIZE);
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  gethostname(buf, sizeof(buf) - 1);
+  return buf;
+}
+
+}  // namespace
+
+int64_t now_utime() {
+  using namespace std::chrono;
+  return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+bool stop_requested() { return g_stop; }
+
+void install_stop_signals() {
+  struct sigaction sa{};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+Process::Process(std::string name, std::string description)
+    : name_(std::move(name)), app_(std::move(description), "traverse-" + name_) {
+  app_.add_option("--config", config_path_, "YAML config file (defaults apply to absent keys)");
+  const char* env_url = std::getenv("LCM_DEFAULT_URL");
+  lcm_url_ = env_url && *env_url ? env_url : kDefaultLcmUrl;
+  app_.add_option("--lcm-url", lcm_url_, "LCM provider URL")->capture_default_str();
+  app_.add_option("--name", name_, "instance name; status goes to STATUS_<NAME>")
+      ->capture_default_str();
+}
+
+Process::~Process() = default;
+
+std::optional<int> Process::parse(int argc, char** argv) {
+  try {
+    app_.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app_.exit(e);  // prints help (rc 0) or the error
+    return rc == 0 ? 0 : kConfigErrorExitCode;
+  }
+  install_stop_signals();
+  start_utime_ = now_utime();
+  return std::nullopt;
+}
+
+void Process::report_config_error(const ConfigError& e) const {
+  spdlog::error("traverse-{}: config error: {}", name_, e.what());
+}
+
+std::optional<int> Process::connect() {
+  bus_ = std::make_unique<Bus>(lcm_url_);
+  if (!bus_->good()) {
+    spdlog::error("traverse-{}: cannot start LCM with URL '{}'", name_, lcm_url_);
+    return 1;
+  }
+  return std::nullopt;
+}
+
+int Process::spin(const std::function<void()>& tick, const std::function<bool()>& until) {
+  publish_status("running");
+  int rc = 0;
+  while (!g_stop && !(until && until())) {
+    if (!bus_->handle(100)) {
+      if (g_stop) break;  // interrupted by the stop signal
+      spdlog::error("traverse-{}: LCM failed while handling messages", name_);
+      rc = 1;
+      break;
+    }
+    if (tick) tick();
+    maybe_publish_status();
+  }
+  publish_status("stopping");
+  return rc;
+}
+
+void Process::maybe_publish_status() {
+  if (now_utime() - last_status_utime_ >= 1'000'000) publish_status("running");
+}
+
+void Process::publish_status(const std::string& state) {
+  if (!bus_) return;
+  process_status_t st;
+  st.utime = now_utime();
+  last_status_utime_ = st.utime;
+  st.process = name_;
+  st.host = host_name();
+  st.pid = getpid();
+  st.uptime_s = 1e-6 * (st.utime - start_utime_);
+  st.cpu_s = cpu_seconds();
+  st.rss_bytes = resident_bytes();
+  st.state = state;
+  for (const auto& [channel, s] : bus_->stats()) {
+    channel_stats_t c;
+    c.channel = channel;
+    c.received = s.received;
+    c.published = s.published;
+    c.decode_failures = s.decode_failures;
+    c.out_of_order = s.out_of_order;
+    c.missed = s.missed;
+    c.handler_errors = s.handler_errors;
+    c.last_utime = s.last_utime;
+    st.channels.push_back(c);
+  }
+  st.n_channels = static_cast<int32_t>(st.channels.size());
+  for (const auto& [k, v] : counters_) {
+    st.counter_names.push_back(k);
+    st.counter_values.push_back(v);
+  }
+  st.n_counters = static_cast<int32_t>(st.counter_names.size());
+  bus_->publish(channels::status_channel(name_), st);
+}
+
+}  // namespace traverse
