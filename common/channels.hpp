@@ -11,6 +11,13 @@ inline const std::string kImu = "IMU";                         // imu_t
 inline const std::string kPoseGroundTruth = "POSE_GROUND_TRUTH";  // pose2d_t, simulator truth
 inline const std::string kPoseReference = "POSE_REFERENCE";    // pose2d_t, external reference
 inline const std::string kPoseFrontend = "POSE_FRONTEND";      // pose2d_t, one per scan
+inline const std::string kKeyPoses = "KEY_POSES";  // key_poses_t, backend key poses (incremental)
+inline const std::string kPoseBackend = "POSE_BACKEND";  // pose2d_t, each backend key pose once
+inline const std::string kPoseDense = "POSE_DENSE";  // pose2d_t, corrected dense trajectory
+inline const std::string kDenseSegment = "DENSE_SEGMENT";  // dense_segment_t, new or moved
+
+// LCM's udpm provider sends one message here when an instance starts: not part of any run.
+inline const std::string kLcmSelfTest = "LCM_SELF_TEST";
 
 // Every process publishes process_status_t once a second on STATUS_<NAME> (name upper-cased).
 std::string status_channel(const std::string& process_name);

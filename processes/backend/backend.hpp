@@ -1,0 +1,164 @@
+// The backend of seed 000 (Karto's mapper and SPA, fed by Hector's trajectory) with the marginal
+// covariances of seed 004, as one algorithm without messaging:
+//   1. the frontend's dense poses are smoothed: the jumps it makes when it recovers at a loop are
+//      replaced by the average of the preceding steps (trajectory_prep.hpp);
+//   2. key poses are picked from them (about three per second, or by distance and angle), and
+//      their scans are kept at reduced density (scan_store.hpp);
+//   3. each new key pose is linked to the previous one by correlative matching (Olson 2009) of its
+//      scan against the last few key scans, searched around the frontend's relative motion with a
+//      penalty for straying from it (correlative_matcher.hpp);
+//   4. loops are closed with the best of all nearby current scans (loop_closer.hpp);
+//   5. the pose graph is optimised by Sparse Pose Adjustment (spa.hpp) and the marginal
+//      covariance of every key pose is recovered from its sparse Cholesky factor.
+// Frontend poses are T_map_base (the frontend's map frame); key poses are T_world_base in the
+// backend's frame, which starts equal to the smoothed frontend frame (first key pose fixed).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "correlative_matcher.hpp"
+#include "loop_closer.hpp"
+#include "pose_graph.hpp"
+#include "scan_store.hpp"
+#include "spa.hpp"
+#include "trajectory_prep.hpp"
+
+namespace traverse::backend {
+
+struct LaserMount {
+  double x_m = 0.0;        // [m] laser origin in the base frame
+  double y_m = 0.0;        // [m]
+  double theta_rad = 0.0;  // [rad] laser heading in the base frame
+
+  template <class V>
+  void visit(V& v) {
+    v("x_m", x_m);
+    v("y_m", y_m);
+    v("theta_rad", theta_rad);
+  }
+};
+
+struct BackendConfig {
+  LaserMount T_base_laser;
+  JumpSmoothingConfig smoothing;
+  KeyPoseConfig key_poses;
+  ScanStoreConfig scans;
+  // Links between consecutive key poses: a narrow search with a strong penalty, so the result
+  // follows the frontend unless the scans clearly say otherwise (seed 000).
+  CorrelativeMatcherConfig link{0.01, 8, 0.002, 0.2, 0.06, 0.03, 0.2, 0.1, 0.05, 8, 400};
+  int link_chain_length = 5;         // previous key scans a new key scan is matched against
+  double min_link_response = 0.35;   // below: the frontend's relative motion is used instead
+  double fallback_sigma_xy_m = 0.05;     // its standard deviation [m]
+  double fallback_sigma_theta_rad = 0.02;  // [rad]
+  LoopCloserConfig loop;
+  SpaConfig spa;
+  int optimize_every = 1;            // key poses between optimisations (always at a closure)
+  int max_pending_scans = 100;       // scans kept while waiting for their pose
+
+  template <class V>
+  void visit(V& v) {
+    v("T_base_laser", T_base_laser);
+    v("smoothing", smoothing);
+    v("key_poses", key_poses);
+    v("scans", scans);
+    v("link", link);
+    v("link_chain_length", link_chain_length);
+    v("min_link_response", min_link_response);
+    v("fallback_sigma_xy_m", fallback_sigma_xy_m);
+    v("fallback_sigma_theta_rad", fallback_sigma_theta_rad);
+    v("loop", loop);
+    v("spa", spa);
+    v("optimize_every", optimize_every);
+    v("max_pending_scans", max_pending_scans);
+  }
+};
+
+// An error message when a value is out of range, empty when the config is valid.
+std::string validate(const BackendConfig& config);
+
+struct KeyPose {
+  int64_t utime = 0;        // [us] time of the frontend pose (its scan's last point)
+  double travel_m = 0.0;    // [m] distance along the smoothed trajectory
+  // Marginal covariance of (x [m], y [m], theta [rad]) in the world frame: m^2, m rad, rad^2.
+  // Zero for the first key pose (it fixes the gauge).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+struct BackendUpdate {
+  int optimisation = 0;                  // 1 for the first optimisation, +1 each
+  std::vector<int> new_key_poses;        // key pose indices added since the previous update
+  std::vector<LoopClosure> new_closures; // closures added since the previous update
+  SpaResult spa;
+  double optimisation_s = 0.0;  // [s] wall time of SPA
+  double marginals_s = 0.0;     // [s] wall time of the covariance recovery
+};
+
+struct BackendCounters {
+  long poses = 0;               // frontend poses received
+  long jumps_smoothed = 0;      // frontend steps replaced by the average
+  long scans = 0;               // scans received
+  long key_poses_without_scan = 0;  // key pose deferred: its scan was missing
+  long links_matched = 0;       // consecutive links from correlative matching
+  long links_fallback = 0;      // ... from the frontend's motion (response too low)
+  long optimisations = 0;
+  long optimisations_failed = 0;  // not converged or covariance not recovered
+  double last_optimisation_s = 0.0;  // [s]
+  double total_optimisation_s = 0.0; // [s]
+};
+
+class Backend {
+ public:
+  // The config must pass validate().
+  explicit Backend(BackendConfig config);
+
+  // A scan of the horizontal scanner (before its frontend pose arrives).
+  void add_scan(PlanarScan scan);
+  // The frontend pose of the scan ending at `utime`; returns an update when the graph was
+  // optimised.
+  std::optional<BackendUpdate> add_pose(int64_t utime, const Pose2& T_map_base);
+  // End of data: closes an open loop-closure episode and optimises if anything is new.
+  std::optional<BackendUpdate> finish();
+
+  const PoseGraph& graph() const { return graph_; }
+  const std::vector<KeyPose>& key_poses() const { return key_poses_; }
+  const ScanStore& scans() const { return scans_; }
+  const std::vector<LoopClosure>& closures() const { return closures_; }
+  const LoopCloserCounters& loop_counters() const { return loop_.counters(); }
+  const BackendCounters& counters() const { return counters_; }
+  int analyses() const { return spa_.system().analyses(); }
+
+ private:
+  Pose2 smooth(int64_t utime, const Pose2& T_map_base);
+  // Adds the key pose at the newest smoothed pose with the points of `scan`.
+  void add_key_pose(const PlanarScan& scan);
+  void add_closure(const LoopClosure& closure);
+  std::optional<BackendUpdate> optimise();
+
+  BackendConfig config_;
+  Pose2 T_base_laser_;
+  CorrelativeMatcher link_matcher_;
+  LoopCloser loop_;
+  SpaOptimizer spa_;
+  BackendCounters counters_;
+
+  std::deque<PlanarScan> pending_scans_;
+  std::vector<StampedPose> tail_;      // the last smoothed poses (window + 1)
+  Pose2 last_raw_;                     // the previous frontend pose
+  std::vector<StampedPose> since_key_; // smoothed poses since the last key pose (inclusive)
+  double travel_m_ = 0.0;
+
+  PoseGraph graph_;
+  std::vector<KeyPose> key_poses_;
+  Pose2 last_key_smoothed_;            // smoothed pose of the last key pose
+  ScanStore scans_;
+  std::vector<LoopClosure> closures_;
+  int first_unreported_key_ = 0;
+  std::size_t first_unreported_closure_ = 0;
+  int optimisations_ = 0;
+};
+
+}  // namespace traverse::backend

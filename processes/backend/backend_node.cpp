@@ -1,0 +1,175 @@
+#include "backend_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "traverse/key_poses_t.hpp"
+
+namespace traverse::backend {
+namespace {
+
+void copy_matrix(const Eigen::Matrix3d& m, double out[9]) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out[3 * r + c] = m(r, c);
+  }
+}
+
+}  // namespace
+
+std::string validate(const BackendNodeConfig& c) {
+  if (c.max_poses_per_message < 1) return "max_poses_per_message must be >= 1";
+  if (c.publish_move_m < 0.0 || c.publish_turn_rad < 0.0 || c.publish_covariance_change < 0.0) {
+    return "publish thresholds must be >= 0";
+  }
+  if (auto e = validate(c.backend); !e.empty()) return "backend." + e;
+  return {};
+}
+
+BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink counters)
+    : bus_(bus), config_(config), backend_(config.backend), counters_(std::move(counters)) {
+  bus_.subscribe<planar_scan_t>(config_.scan_channel,
+                                [this](const planar_scan_t& m) { on_scan(m); });
+  bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
+}
+
+void BackendNode::on_scan(const planar_scan_t& msg) {
+  PlanarScan scan;
+  scan.utime_first = msg.utime_first;
+  scan.utime_last = msg.utime_last;
+  scan.angle_first = msg.angle_first;
+  scan.angle_step = msg.angle_step;
+  scan.range_min = msg.range_min;
+  scan.range_max = msg.range_max;
+  scan.ranges = msg.ranges;
+  backend_.add_scan(std::move(scan));
+}
+
+void BackendNode::on_pose(const pose2d_t& msg) {
+  if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
+  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta))) publish(*update);
+}
+
+void BackendNode::finish() {
+  if (auto update = backend_.finish()) publish(*update);
+}
+
+bool BackendNode::changed(int i) const {
+  if (i >= static_cast<int>(published_.size())) return true;
+  const Published& p = published_[i];
+  const Pose2& T = backend_.graph().poses[i];
+  if ((T.translation() - p.T_world_base.translation()).norm() > config_.publish_move_m) return true;
+  if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
+    return true;
+  }
+  const Eigen::Vector3d v = backend_.key_poses()[i].covariance.diagonal();
+  for (int k = 0; k < 3; ++k) {
+    if (std::abs(v[k] - p.variances[k]) > config_.publish_covariance_change * std::abs(p.variances[k]))
+      return true;
+  }
+  return false;
+}
+
+void BackendNode::publish(const BackendUpdate& update) {
+  const std::vector<KeyPose>& keys = backend_.key_poses();
+  const PoseGraph& graph = backend_.graph();
+  if (keys.empty()) return;
+  std::vector<int> changed_ids;
+  for (int i = 0; i < static_cast<int>(keys.size()); ++i) {
+    if (changed(i)) changed_ids.push_back(i);
+  }
+  published_.resize(keys.size());
+  for (int i : changed_ids) published_[i] = {graph.poses[i], keys[i].covariance.diagonal()};
+
+  const int per = config_.max_poses_per_message;
+  const int parts = std::max(1, static_cast<int>((changed_ids.size() + per - 1) / per));
+  const double chi2_now = chi2(graph);
+  for (int part = 0; part < parts; ++part) {
+    key_poses_t msg{};
+    msg.utime = keys.back().utime;
+    msg.optimisation = update.optimisation;
+    msg.part = part;
+    msg.parts = parts;
+    msg.total_key_poses = static_cast<int32_t>(keys.size());
+    msg.total_loop_closures = static_cast<int32_t>(backend_.closures().size());
+    msg.optimisation_s = update.optimisation_s;
+    msg.chi2 = chi2_now;
+    const std::size_t lo = static_cast<std::size_t>(part) * per;
+    const std::size_t hi = std::min(changed_ids.size(), lo + per);
+    for (std::size_t k = lo; k < hi; ++k) {
+      const int i = changed_ids[k];
+      key_pose_t p{};
+      p.utime = keys[i].utime;
+      p.id = i;
+      p.x = graph.poses[i].x();
+      p.y = graph.poses[i].y();
+      p.theta = graph.poses[i].theta();
+      copy_matrix(keys[i].covariance, p.covariance);
+      msg.poses.push_back(p);
+    }
+    msg.n_poses = static_cast<int32_t>(msg.poses.size());
+    if (part == 0) {
+      for (const LoopClosure& c : update.new_closures) {
+        loop_closure_t l{};
+        l.utime = keys[c.to].utime;
+        l.from_utime = keys[c.from].utime;
+        l.from_id = c.from;
+        l.to_id = c.to;
+        l.x = c.T_from_to.x();
+        l.y = c.T_from_to.y();
+        l.theta = c.T_from_to.theta();
+        copy_matrix(c.covariance, l.covariance);
+        l.response = c.response;
+        l.candidates = c.candidates_tried;
+        msg.closures.push_back(l);
+      }
+    }
+    msg.n_closures = static_cast<int32_t>(msg.closures.size());
+    max_message_bytes_ = std::max(max_message_bytes_, static_cast<std::size_t>(msg.getEncodedSize()));
+    bus_.publish(config_.key_poses_channel, msg);
+    ++messages_;
+  }
+
+  // The trajectory for evaluators: each new key pose once, at its estimate of this optimisation.
+  for (int i : update.new_key_poses) {
+    pose2d_t pose{};
+    pose.utime = keys[i].utime;
+    pose.parent_frame = "world";
+    pose.child_frame = "base";
+    pose.x = graph.poses[i].x();
+    pose.y = graph.poses[i].y();
+    pose.theta = graph.poses[i].theta();
+    copy_matrix(keys[i].covariance, pose.covariance);
+    pose.flags = pose2d_t::FLAG_KEY_POSE;
+    bus_.publish(config_.trajectory_channel, pose);
+  }
+}
+
+void BackendNode::report_counters() {
+  if (!counters_) return;
+  const BackendCounters& c = backend_.counters();
+  const LoopCloserCounters& l = backend_.loop_counters();
+  counters_("poses_received", static_cast<double>(c.poses));
+  counters_("scans_received", static_cast<double>(c.scans));
+  counters_("jumps_smoothed", static_cast<double>(c.jumps_smoothed));
+  counters_("key_poses", static_cast<double>(backend_.key_poses().size()));
+  counters_("key_poses_without_scan", static_cast<double>(c.key_poses_without_scan));
+  counters_("links_matched", static_cast<double>(c.links_matched));
+  counters_("links_fallback", static_cast<double>(c.links_fallback));
+  counters_("loop_closures", static_cast<double>(backend_.closures().size()));
+  counters_("loop_episodes", static_cast<double>(l.episodes));
+  counters_("loop_candidates", static_cast<double>(l.candidates));
+  counters_("loop_rejected_response", static_cast<double>(l.rejected_response));
+  counters_("loop_rejected_ambiguous", static_cast<double>(l.rejected_ambiguous));
+  counters_("loop_rejected_covariance", static_cast<double>(l.rejected_covariance));
+  counters_("optimisations", static_cast<double>(c.optimisations));
+  counters_("optimisations_failed", static_cast<double>(c.optimisations_failed));
+  counters_("optimisation_last_s", c.last_optimisation_s);
+  counters_("optimisation_total_s", c.total_optimisation_s);
+  counters_("symbolic_analyses", static_cast<double>(backend_.analyses()));
+  counters_("scan_store_bytes", static_cast<double>(backend_.scans().memory_bytes()));
+  counters_("scan_bytes_per_key_pose", backend_.scans().bytes_per_key_pose());
+  counters_("key_poses_messages", static_cast<double>(messages_));
+  counters_("key_poses_message_max_bytes", static_cast<double>(max_message_bytes_));
+}
+
+}  // namespace traverse::backend

@@ -1,0 +1,117 @@
+// Loop closure as seed 000 modifies Karto's: when the platform comes near an old chain of key
+// scans, EVERY nearby current key scan is matched against that chain, and the loop is closed with
+// the best response of them all, not with the first one over a threshold (the match generally
+// improves as the scanning positions get closer).
+//
+// An episode starts when the newest key pose lies within `search_radius_m` of key poses that are
+// at least `min_travel_m` back along the trajectory; the chain is the run of such old key poses
+// around the nearest one. Each current key scan of the episode is a candidate. The episode ends
+// when the platform leaves the old chain or after `max_candidates` candidates (so a long retraced
+// corridor gets several closures); its best accepted candidate becomes the closure.
+//
+// A wrong closure is worse than a missed one, so a candidate is accepted only if
+//  1. a coarse correlative search over a wide window finds a response over min_coarse_response,
+//  2. the scene is not ambiguous: the best response at least ambiguity_exclusion_m away from the
+//     peak is below max_ambiguity_ratio times the peak (repeated rooms, corridors),
+//  3. a fine search around the coarse peak has a response over min_fine_response, and
+//  4. the fine covariance is tight (standard deviations under max_sigma_xy_m, max_sigma_theta_rad).
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "correlative_matcher.hpp"
+#include "scan_store.hpp"
+#include "se2.hpp"
+
+namespace traverse::backend {
+
+struct LoopCloserConfig {
+  double search_radius_m = 2.5;    // old key poses this close to the newest start an episode [m]
+  double min_travel_m = 10.0;      // ... if at least this far back along the trajectory [m]
+  double chain_radius_m = 8.0;     // chain: old key poses within this of the newest pose [m]
+  int max_chain_length = 30;       // key scans in a chain at most
+  int max_candidates = 9;          // current key scans tried per episode (~3 s at 3 Hz)
+  double min_coarse_response = 0.5;     // [0..1]
+  double min_fine_response = 0.6;       // [0..1]
+  double max_ambiguity_ratio = 0.85;    // second peak / peak above this: ambiguous, rejected
+  double ambiguity_exclusion_m = 0.6;   // the second peak lies at least this far from the peak [m]
+  double max_sigma_xy_m = 0.08;         // largest standard deviation of the fine match [m]
+  double max_sigma_theta_rad = 0.02;    // [rad]
+  CorrelativeMatcherConfig coarse{0.05, 8, 0.01, 2.0, 0.35, 0.06, 10.0, 2.0, 0.05, 10, 300};
+  CorrelativeMatcherConfig fine{0.01, 4, 0.001, 0.12, 0.03, 0.03, 10.0, 2.0, 0.05, 8, 400};
+
+  template <class V>
+  void visit(V& v) {
+    v("search_radius_m", search_radius_m);
+    v("min_travel_m", min_travel_m);
+    v("chain_radius_m", chain_radius_m);
+    v("max_chain_length", max_chain_length);
+    v("max_candidates", max_candidates);
+    v("min_coarse_response", min_coarse_response);
+    v("min_fine_response", min_fine_response);
+    v("max_ambiguity_ratio", max_ambiguity_ratio);
+    v("ambiguity_exclusion_m", ambiguity_exclusion_m);
+    v("max_sigma_xy_m", max_sigma_xy_m);
+    v("max_sigma_theta_rad", max_sigma_theta_rad);
+    v("coarse", coarse);
+    v("fine", fine);
+  }
+};
+
+std::string validate(const LoopCloserConfig& config);
+
+struct LoopClosure {
+  int from = 0;     // old key pose of the chain (nearest to the match)
+  int to = 0;       // current key pose
+  Pose2 T_from_to;  // measured pose of `to` in the frame of `from`
+  // Covariance of the measurement on (x [m], y [m], theta [rad]) in the frame of `to`, as the
+  // pose graph's edge error is expressed: m^2, m rad, rad^2.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  double response = 0.0;       // fine raw response [0..1]
+  double second_peak = 0.0;    // coarse ambiguity ratio (second peak / peak)
+  int candidates_tried = 0;    // candidates of the episode
+};
+
+struct LoopCloserCounters {
+  long episodes = 0;
+  long candidates = 0;             // key scans matched against a chain
+  long rejected_response = 0;      // coarse or fine response too low
+  long rejected_ambiguous = 0;
+  long rejected_covariance = 0;
+  long closures = 0;
+};
+
+class LoopCloser {
+ public:
+  // The config must pass validate().
+  explicit LoopCloser(LoopCloserConfig config);
+
+  // Key pose `current` is the newest; poses are the current estimates T_world_base of all key
+  // poses and travel_m their distance along the trajectory [m]. Returns a closure when this call
+  // ends an episode that had an accepted candidate.
+  std::optional<LoopClosure> add(int current, const std::vector<Pose2>& poses,
+                                 const std::vector<double>& travel_m, const ScanStore& scans);
+  // Ends the open episode (end of data).
+  std::optional<LoopClosure> finish();
+
+  // One candidate: the current key scan against the chain [chain_first, chain_last]; nullopt when
+  // a check rejects it (counted). Exposed for tests.
+  std::optional<LoopClosure> try_candidate(int current, int chain_first, int chain_last,
+                                           const std::vector<Pose2>& poses,
+                                           const ScanStore& scans);
+
+  const LoopCloserCounters& counters() const { return counters_; }
+
+ private:
+  LoopCloserConfig config_;
+  CorrelativeMatcher coarse_, fine_;
+  LoopCloserCounters counters_;
+  bool open_ = false;
+  int chain_first_ = 0, chain_last_ = 0;  // chain of the open episode
+  int episode_candidates_ = 0;
+  std::optional<LoopClosure> best_;
+};
+
+}  // namespace traverse::backend

@@ -1,0 +1,73 @@
+// Key scans of the backend, kept in memory at reduced density.
+//
+// A key scan is converted once to points in the base frame of its key pose: every beam is placed
+// with the pose at its own time (motion during the sweep undone with the frontend's trajectory,
+// as seed 000 does for Hector), then the points are thinned along the sweep so that consecutive
+// kept points are at least `point_spacing_m` apart. The matcher blurs its table by a few
+// centimetres anyway, so nothing finer is needed. Points are stored as float pairs (8 bytes): at
+// 0.05 m spacing an office scan (60-120 m of visible wall) keeps 1,000-2,500 points, i.e. about
+// 8-20 KB per key pose (memory_bytes() reports the real figure), against 43 KB for the raw sweep.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "se2.hpp"
+
+namespace traverse::backend {
+
+// One sweep of the planar scanner, as published (beam i at utime_first + i * (utime_last -
+// utime_first) / (n - 1), along angle_first + i * angle_step in the laser frame).
+struct PlanarScan {
+  int64_t utime_first = 0;    // [us]
+  int64_t utime_last = 0;     // [us]
+  double angle_first = 0.0;   // [rad] laser frame
+  double angle_step = 0.0;    // [rad]
+  double range_min = 0.0;     // [m]
+  double range_max = 0.0;     // [m]
+  std::vector<float> ranges;  // [m]; NaN, 0 or outside [range_min, range_max]: no return
+};
+
+struct ScanStoreConfig {
+  double point_spacing_m = 0.05;  // minimum distance between consecutive kept points [m]
+  double min_range_m = 0.3;       // readings closer than this are dropped (the cart itself) [m]
+  double max_range_m = 30.0;      // readings farther than this are dropped [m]
+
+  template <class V>
+  void visit(V& v) {
+    v("point_spacing_m", point_spacing_m);
+    v("min_range_m", min_range_m);
+    v("max_range_m", max_range_m);
+  }
+};
+
+// Points of `scan` in the base frame at time utime_ref: beam i is placed with
+// T_ref_base(t_i) * T_base_laser, where T_ref_base(t) is the motion of the base relative to its
+// pose at utime_ref. Thinned as described above.
+std::vector<Eigen::Vector2f> reduce_scan(const PlanarScan& scan, const Pose2& T_base_laser,
+                                         const std::function<Pose2(int64_t)>& T_ref_base,
+                                         const ScanStoreConfig& config);
+
+class ScanStore {
+ public:
+  // Stores the points of one key scan; returns its index (the key pose index).
+  int add(std::vector<Eigen::Vector2f> points_base);
+  int size() const { return static_cast<int>(scans_.size()); }
+  const std::vector<Eigen::Vector2f>& points(int index) const { return scans_[index]; }
+  // Points of scan `index` moved into the world frame by T_world_base, appended to `out`.
+  void append_world(int index, const Pose2& T_world_base, std::vector<Eigen::Vector2d>& out) const;
+  // Points as doubles in the base frame (the matcher's query).
+  std::vector<Eigen::Vector2d> points_d(int index) const;
+
+  // Heap memory held by the stored points [bytes], and per key pose on average [bytes].
+  std::size_t memory_bytes() const { return bytes_; }
+  double bytes_per_key_pose() const;
+
+ private:
+  std::vector<std::vector<Eigen::Vector2f>> scans_;
+  std::size_t bytes_ = 0;
+};
+
+}  // namespace traverse::backend

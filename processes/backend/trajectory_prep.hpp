@@ -1,0 +1,71 @@
+// Preparing the frontend's dense trajectory for the backend (seed 000, section "pipeline"):
+//  1. Jump smoothing. A scan matcher without a backend recovers from accumulated drift at a loop
+//     with a discrete jump. Each step between consecutive poses is compared with the average of
+//     the preceding steps (as velocities, so uneven scan timing does not matter); a step much
+//     longer, or in a clearly different direction, is replaced by that average, and the rest of
+//     the trajectory is carried along so it stays continuous.
+//  2. Key-pose selection: a pose becomes a key pose when enough time has passed since the last
+//     one (seed 000 uses three per second), or when the platform has moved or turned enough.
+// Poses are T_world_base, times in microseconds.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "se2.hpp"
+
+namespace traverse::backend {
+
+struct StampedPose {
+  int64_t utime = 0;  // [us]
+  Pose2 T_world_base;
+};
+
+struct JumpSmoothingConfig {
+  int window = 10;                        // preceding steps averaged [steps]
+  double speed_ratio = 3.0;               // a step faster than ratio * average speed is a jump
+  double min_jump_speed_mps = 0.5;        // ... and faster than this [m/s] (ignores jitter at rest)
+  double max_direction_change_rad = 1.0;  // step direction vs average direction, while moving
+  double min_moving_speed_mps = 0.1;  // below this average speed, direction is not checked [m/s]
+  double max_turn_rate_radps = 3.0;   // a heading rate above this [rad/s] is a jump
+
+  template <class V>
+  void visit(V& v) {
+    v("window", window);
+    v("speed_ratio", speed_ratio);
+    v("min_jump_speed_mps", min_jump_speed_mps);
+    v("max_direction_change_rad", max_direction_change_rad);
+    v("min_moving_speed_mps", min_moving_speed_mps);
+    v("max_turn_rate_radps", max_turn_rate_radps);
+  }
+};
+
+struct SmoothedTrajectory {
+  std::vector<StampedPose> poses;
+  std::vector<int> replaced_steps;  // index k of every step k-1 -> k replaced by the average
+};
+
+// Returns the trajectory with jumps replaced; the first pose is kept as is. Poses must be in
+// time order (equal times are treated as a 1 us step).
+SmoothedTrajectory smooth_jumps(const std::vector<StampedPose>& poses,
+                                const JumpSmoothingConfig& config);
+
+struct KeyPoseConfig {
+  int64_t interval_us = 333333;  // a key pose at least this often [us]; 0: not by time
+  double distance_m = 0.0;       // ... or after this travelled distance [m]; 0: not by distance
+  double angle_rad = 0.0;        // ... or after this turned angle [rad]; 0: not by angle
+
+  template <class V>
+  void visit(V& v) {
+    v("interval_us", interval_us);
+    v("distance_m", distance_m);
+    v("angle_rad", angle_rad);
+  }
+};
+
+// Indices of the key poses: the first pose, then every pose at which one of the enabled criteria
+// is reached since the last key pose (distance and angle accumulated along the trajectory).
+std::vector<int> select_key_poses(const std::vector<StampedPose>& poses,
+                                  const KeyPoseConfig& config);
+
+}  // namespace traverse::backend

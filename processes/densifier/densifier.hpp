@@ -1,0 +1,127 @@
+// Densification (seed 000, section 2): the backend optimises only a sparse subset of the scans
+// (key poses, about three per second), while the tilted scanner needs a pose for each of its
+// points. The dense frontend trajectory D(t) is therefore bent so that every sub-trajectory
+// between two consecutive key poses a, b meets their optimised poses K_a, K_b.
+//
+// Two ways to bend a segment:
+//  - kPaper (seed 000): a similarity transform of the positions (rotation, uniform scale,
+//    translation) that maps D(t_a), D(t_b) onto K_a, K_b; headings get the end-point heading
+//    corrections interpolated in time. Seed 000's discussion names its flaw: when the platform
+//    stands nearly still the chord |D(t_b) - D(t_a)| is tiny, the scale |K_b - K_a| / |D_b - D_a|
+//    is arbitrary, and the frontend's millimetre jitter is magnified to centimetres.
+//  - kRigid (default): the world-frame corrections C_a = K_a D_a^-1 and C_b = K_b D_b^-1 are
+//    interpolated on SE(2) by the fraction s of the segment's travel done at t (distance plus
+//    a lever arm times the turned angle; time when the platform did not move), and each pose
+//    becomes C(s) D(t). Every pose is moved rigidly, so jitter is never magnified; the end poses
+//    are met exactly.
+//
+// The Densifier keeps the whole dense trajectory and the key poses, which may be re-optimised
+// any number of times; it returns the segments whose corrected poses appeared or moved.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "se2.hpp"
+
+namespace traverse::densifier {
+
+enum class Mode { kPaper, kRigid };
+
+struct DensifierConfig {
+  std::string mode = "rigid";          // "rigid" (interpolated rigid correction) or "paper"
+  double turn_lever_m = 0.5;           // [m/rad] a turn of 1 rad counts as this much travel
+  double republish_threshold_m = 1e-4;     // [m] a segment moving less is not sent again
+  double republish_threshold_rad = 1e-5;   // [rad] same for headings
+  std::string parent_frame = "world";  // frame of the published poses
+  std::string key_pose_channel = "KEY_POSES";  // key_poses_t from the backend
+  template <class V>
+  void visit(V& v) {
+    v("mode", mode);
+    v("turn_lever_m", turn_lever_m);
+    v("republish_threshold_m", republish_threshold_m);
+    v("republish_threshold_rad", republish_threshold_rad);
+    v("parent_frame", parent_frame);
+    v("key_pose_channel", key_pose_channel);
+  }
+};
+
+// "paper" or "rigid"; nullopt for anything else.
+std::optional<Mode> parse_mode(const std::string& name);
+
+struct StampedPose {
+  int64_t utime = 0;  // [us]
+  Pose2 T_world_base;
+};
+
+struct KeyPose {
+  int64_t id = 0;     // backend's key pose id
+  int64_t utime = 0;  // [us] time of the scan the key pose belongs to
+  Pose2 T_world_base;  // optimised pose
+};
+
+// One corrected segment from key pose `key_id_first` to `key_id_last`, both end poses included.
+struct Segment {
+  int64_t key_id_first = 0, key_id_last = 0;
+  int revision = 0;  // 0 when first closed, +1 per move
+  std::vector<StampedPose> poses;
+};
+
+// Bends `dense` (poses of one segment, increasing time, including both ends' times) so that the
+// dense poses D_a at `dense.front()` and D_b at `dense.back()` land on K_a and K_b.
+std::vector<StampedPose> correct_segment(const std::vector<StampedPose>& dense, const Pose2& K_a,
+                                         const Pose2& K_b, Mode mode, double turn_lever_m);
+
+// Pose at `utime` by geodesic interpolation in a time-ordered pose list; nullopt outside it.
+std::optional<Pose2> interpolate_at(const std::vector<StampedPose>& poses, int64_t utime);
+
+class Densifier {
+ public:
+  explicit Densifier(const DensifierConfig& config);
+
+  // Appends a frontend pose (time must increase; false and ignored otherwise). Returns the
+  // segments this closes (a key pose already known but ahead of the dense data).
+  bool add_dense(int64_t utime, const Pose2& T_world_base, std::vector<Segment>* closed);
+  // Adds or re-optimises key poses (identified by utime). Returns the segments that were closed
+  // for the first time or moved by more than the republish thresholds.
+  std::vector<Segment> update_key_poses(const std::vector<KeyPose>& keys);
+
+  // Corrected pose at `utime`: bent inside closed segments, and moved rigidly with the nearest
+  // key pose's correction before the first and after the last closed key pose.
+  std::optional<Pose2> pose_at(int64_t utime) const;
+  // The whole corrected trajectory (one pose per dense pose).
+  std::vector<StampedPose> corrected_trajectory() const;
+
+  std::size_t dense_size() const { return dense_.size(); }
+  std::size_t key_size() const { return keys_.size(); }
+  int64_t segments_moved() const { return segments_moved_; }
+
+ private:
+  struct KeyState {
+    KeyPose key;
+    bool placed = false;  // the dense data reached its time and its segment(s) were computed
+  };
+  struct SegmentState {
+    int64_t utime_last = 0;
+    int revision = -1;
+    std::vector<StampedPose> poses;
+  };
+  // Dense poses with utime in [t0, t1], and the dense pose interpolated at both ends.
+  std::vector<StampedPose> dense_between(int64_t t0, int64_t t1) const;
+  // Recomputes the segment starting at key `it`; appends it to `out` if new or moved.
+  void refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out);
+  // Correction K D^-1 of a placed key pose.
+  Pose2 correction(const KeyState& k) const;
+
+  DensifierConfig config_;
+  Mode mode_;
+  std::vector<StampedPose> dense_;
+  std::map<int64_t, KeyState> keys_;          // by utime
+  std::map<int64_t, SegmentState> segments_;  // by start key utime
+  int64_t segments_moved_ = 0;
+};
+
+}  // namespace traverse::densifier

@@ -1,0 +1,152 @@
+// traverse-evaluator: compares a trajectory channel with ground truth or reference poses, offline
+// on an LCM log (--log) or live in the graph (outputs written at SIGINT/SIGTERM). Writes
+// errors.csv and errors.png under --out and prints one JSON summary line last.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+#include <vector>
+
+#include "channels.hpp"
+#include "evaluator.hpp"
+#include "pose_collector.hpp"
+#include "process.hpp"
+#include "report.hpp"
+
+namespace {
+
+namespace ev = traverse::evaluator;
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string log;
+  std::string estimate = traverse::channels::kPoseFrontend;
+  std::string reference = traverse::channels::kPoseGroundTruth;
+  std::string out;
+  std::string align;
+  std::vector<double> shift;  // dx [m], dy [m], dtheta [rad]
+};
+
+// Offline runs must not need a network: look for --log before the process connects to LCM.
+bool has_log_option(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--log") == 0 || std::strncmp(argv[i], "--log=", 6) == 0) return true;
+  }
+  return false;
+}
+
+void add_options(CLI::App& app, Options& opt) {
+  app.add_option("--log", opt.log, "evaluate this LCM log offline instead of listening live")
+      ->check(CLI::ExistingFile);
+  app.add_option("--estimate", opt.estimate, "pose2d_t channel of the estimated trajectory")
+      ->capture_default_str();
+  app.add_option("--reference", opt.reference,
+                 "pose2d_t channel of the reference (ground truth or reference poses)")
+      ->capture_default_str();
+  app.add_option("--out", opt.out, "directory for errors.csv and errors.png");
+  app.add_option("--align", opt.align, "override the config's align: none, first_pose or se2")
+      ->check(CLI::IsMember({"none", "first_pose", "se2"}));
+  app.add_option("--shift-estimate", opt.shift,
+                 "DX DY DTHETA: add [m], [m], [rad] to every estimate pose first (a known error "
+                 "to check the evaluator with; use --align none)")
+      ->expected(3)
+      ->allow_extra_args(false);
+}
+
+// errors.csv and errors.png under --out, their paths (or why there is no plot) in the JSON.
+bool write_outputs(const Options& opt, const ev::Evaluation& evaluation, ev::JsonLine& json) {
+  std::error_code ec;
+  fs::create_directories(opt.out, ec);
+  const std::string csv = (fs::path(opt.out) / "errors.csv").string();
+  const std::string png = (fs::path(opt.out) / "errors.png").string();
+  if (!ev::write_errors_csv(evaluation, csv)) {
+    spdlog::error("traverse-evaluator: cannot write {}", csv);
+    return false;
+  }
+  json.add("errors_csv", csv);
+  if (evaluation.matched == 0) {
+    json.add_null("errors_png").add("plot_note", "nothing matched, nothing to plot");
+    return true;
+  }
+  const double rmse_m = evaluation.position_m.rmse;
+  const std::string title = fmt::format(
+      "{} vs {} (align {}): position RMSE {}, heading RMSE {:.3f} deg", opt.estimate, opt.reference,
+      ev::align_name(evaluation.alignment.used),
+      rmse_m < 1.0 ? fmt::format("{:.1f} mm", 1e3 * rmse_m) : fmt::format("{:.3f} m", rmse_m),
+      180.0 / M_PI * evaluation.heading_rad.rmse);
+  const auto plot_problem = ev::plot_errors(
+      std::string(TRAVERSE_SOURCE_DIR) + "/scripts/plot_errors.py", csv, png, title);
+  if (plot_problem) {
+    spdlog::warn("traverse-evaluator: {}", *plot_problem);
+    json.add_null("errors_png").add("plot_note", *plot_problem);
+  } else {
+    json.add("errors_png", png);
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spdlog::set_default_logger(spdlog::stderr_color_mt("evaluator"));
+  traverse::Process proc("evaluator",
+                         "Compares a trajectory channel with ground truth or reference poses "
+                         "(seed 000 Table 2 figures, relative pose error, largest jump).");
+  Options opt;
+  add_options(proc.cli(), opt);
+  ev::EvaluatorConfig cfg;
+  const bool offline = has_log_option(argc, argv);
+  if (auto rc = proc.start(argc, argv, cfg, !offline)) return *rc;
+  if (!opt.align.empty()) cfg.align = opt.align;
+  if (auto error = ev::validate(cfg)) {
+    spdlog::error("traverse-evaluator: config error: {} (in {})", *error,
+                  proc.config_path().empty() ? "defaults" : proc.config_path());
+    return traverse::kConfigErrorExitCode;
+  }
+
+  ev::PoseCollector collector(opt.estimate, opt.reference);
+  ev::PoseCollector::LogSummary log_summary;
+  if (offline) {
+    try {
+      log_summary = collector.read_log(opt.log);
+    } catch (const std::runtime_error& e) {
+      spdlog::error("traverse-evaluator: {}", e.what());
+      return 1;
+    }
+  } else {
+    collector.subscribe(proc.bus());
+    const int rc = proc.spin([&] {
+      proc.counter("estimate_poses") = static_cast<double>(collector.estimate().size());
+      proc.counter("reference_poses") = static_cast<double>(collector.reference().size());
+    });
+    if (rc != 0) return rc;
+  }
+
+  ev::Trajectory estimate = collector.estimate();
+  if (opt.shift.size() == 3) ev::shift(estimate, opt.shift[0], opt.shift[1], opt.shift[2]);
+  const ev::Evaluation evaluation = ev::evaluate(estimate, collector.reference(), cfg);
+
+  ev::JsonLine json;
+  ev::add_evaluation(evaluation, json);
+  json.add("estimate_channel", opt.estimate)
+      .add("reference_channel", opt.reference)
+      .add_int("non_finite_poses", static_cast<long long>(collector.non_finite_poses()));
+  if (offline) {
+    json.add("log", opt.log)
+        .add_int("log_damaged_records", static_cast<long long>(log_summary.damaged_records))
+        .add_int("decode_failures", static_cast<long long>(log_summary.decode_failures));
+  }
+  int rc = evaluation.matched > 0 ? 0 : 1;
+  if (evaluation.matched == 0) {
+    spdlog::error(
+        "traverse-evaluator: no estimate pose on {} matched a pose on {} ({} and {} poses)",
+        opt.estimate, opt.reference, evaluation.estimate_poses, evaluation.reference_poses);
+  }
+  if (!opt.out.empty() && !write_outputs(opt, evaluation, json)) return 1;
+  std::cout << json.str() << std::endl;
+  return rc;
+}

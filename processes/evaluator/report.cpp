@@ -1,0 +1,154 @@
+#include "report.hpp"
+
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace traverse::evaluator {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+// Exit code of plot_errors.py when matplotlib cannot be imported.
+constexpr int kNoMatplotlibExitCode = 3;
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// Runs argv with stdout sent to stderr; the exit code, or -1 if it could not be run.
+int run(const std::vector<std::string>& args) {
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    dup2(STDERR_FILENO, STDOUT_FILENO);  // our stdout ends with the JSON line alone
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status);
+}
+
+}  // namespace
+
+bool write_errors_csv(const Evaluation& ev, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) return false;
+  out << "utime_us,time_s,travel_m,position_error_m,heading_error_deg,"
+         "est_x_m,est_y_m,est_theta_deg,ref_x_m,ref_y_m,ref_theta_deg\n";
+  const int64_t t0 = ev.samples.empty() ? 0 : ev.samples.front().utime;
+  for (const ErrorSample& s : ev.samples) {
+    out << fmt::format("{},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f}\n",
+                       s.utime, 1e-6 * static_cast<double>(s.utime - t0), s.travel_m,
+                       s.position_error_m, kDegPerRad * s.heading_error_rad, s.T_ref_est.x(),
+                       s.T_ref_est.y(), kDegPerRad * s.T_ref_est.theta(), s.T_ref_true.x(),
+                       s.T_ref_true.y(), kDegPerRad * s.T_ref_true.theta());
+  }
+  return static_cast<bool>(out.flush());
+}
+
+std::optional<std::string> plot_errors(const std::string& script, const std::string& csv,
+                                       const std::string& png, const std::string& title) {
+  if (access(script.c_str(), R_OK) != 0) return "plot script not found: " + script;
+  // Debian's interpreter first: it is the one python3-matplotlib installs into.
+  int rc = -1;
+  for (const char* python : {"/usr/bin/python3", "python3"}) {
+    rc = run({python, script, csv, png, "--title", title});
+    if (rc == 0) return std::nullopt;
+    if (rc != kNoMatplotlibExitCode && rc != 127 && rc != -1) break;
+  }
+  if (rc == kNoMatplotlibExitCode || rc == 127 || rc == -1) {
+    return "no plot: python3 with matplotlib not found (install python3-matplotlib)";
+  }
+  return fmt::format("no plot: {} failed with exit code {}", script, rc);
+}
+
+JsonLine& JsonLine::add(const std::string& key, const std::string& value) {
+  fields_.emplace_back(key, fmt::format("\"{}\"", json_escape(value)));
+  return *this;
+}
+
+JsonLine& JsonLine::add(const std::string& key, double value, int decimals) {
+  if (!std::isfinite(value)) return add_null(key);
+  fields_.emplace_back(key, fmt::format("{:.{}f}", value, decimals));
+  return *this;
+}
+
+JsonLine& JsonLine::add(const std::string& key, std::optional<double> value, int decimals) {
+  return value ? add(key, *value, decimals) : add_null(key);
+}
+
+JsonLine& JsonLine::add_int(const std::string& key, long long value) {
+  fields_.emplace_back(key, std::to_string(value));
+  return *this;
+}
+
+JsonLine& JsonLine::add_null(const std::string& key) {
+  fields_.emplace_back(key, "null");
+  return *this;
+}
+
+std::string JsonLine::str() const {
+  std::string out = "{";
+  for (std::size_t i = 0; i < fields_.size(); ++i) {
+    if (i > 0) out += ", ";
+    out += fmt::format("\"{}\": {}", json_escape(fields_[i].first), fields_[i].second);
+  }
+  return out + "}";
+}
+
+void add_evaluation(const Evaluation& ev, JsonLine& json) {
+  // With nothing matched there are no errors to report, not zero errors.
+  const auto figure = [&](double value) {
+    return ev.matched > 0 ? std::optional<double>(value) : std::nullopt;
+  };
+  json.add("position_rmse_m", figure(ev.position_m.rmse))
+      .add("position_sd_m", figure(ev.position_m.sd))
+      .add("position_max_m", figure(ev.position_m.max))
+      .add("heading_rmse_deg", figure(kDegPerRad * ev.heading_rad.rmse))
+      .add("heading_sd_deg", figure(kDegPerRad * ev.heading_rad.sd))
+      .add("heading_max_deg", figure(kDegPerRad * ev.heading_rad.max))
+      .add("rpe_1m_m", ev.rpe_1m.rms_m)
+      .add("rpe_10m_m", ev.rpe_10m.rms_m)
+      .add_int("rpe_1m_pairs", static_cast<long long>(ev.rpe_1m.pairs))
+      .add_int("rpe_10m_pairs", static_cast<long long>(ev.rpe_10m.pairs))
+      .add("max_jump_m", figure(ev.max_jump.step_error_m));
+  if (ev.samples.size() >= 2) {
+    const int64_t t0 = ev.samples.front().utime;
+    json.add("max_jump_time_s",
+             1e-6 * static_cast<double>(ev.samples[ev.max_jump.index].utime - t0), 3);
+  } else {
+    json.add_null("max_jump_time_s");
+  }
+  json.add_int("matched", static_cast<long long>(ev.matched))
+      .add_int("unmatched", static_cast<long long>(ev.unmatched))
+      .add_int("estimate_poses", static_cast<long long>(ev.estimate_poses))
+      .add_int("reference_poses", static_cast<long long>(ev.reference_poses))
+      .add("duration_s", ev.duration_s, 3)
+      .add("length_m", ev.length_m, 3)
+      .add("align", align_name(ev.alignment.used))
+      .add("align_x_m", ev.alignment.T_ref_est.x())
+      .add("align_y_m", ev.alignment.T_ref_est.y())
+      .add("align_theta_deg", kDegPerRad * ev.alignment.T_ref_est.theta());
+}
+
+}  // namespace traverse::evaluator

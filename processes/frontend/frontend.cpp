@@ -1,0 +1,219 @@
+#include "frontend.hpp"
+
+#include "deskew.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace traverse::frontend {
+namespace {
+
+// A sweep longer than this is not a sweep of a planar scanner: its times are wrong.
+constexpr int64_t kMaxSweepUs = 1'000'000;
+// IMU silent for longer than this: rotation comes from constant velocity instead.
+constexpr int64_t kImuStaleUs = 500'000;
+// Velocity estimates closer than this in time are averaged (exponentially) to tame the noise of
+// differencing poses a few milliseconds apart.
+constexpr double kVelocitySmoothingS = 0.1;
+// Scans further apart than this do not come from a scanner's stream (see predict()).
+constexpr int64_t kMaxStreamIntervalUs = 500'000;
+
+Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+}  // namespace
+
+Frontend::Frontend(const FrontendConfig& config)
+    : config_(config),
+      T_base_laser_(config.T_base_laser.x_m, config.T_base_laser.y_m,
+                    config.T_base_laser.theta_rad),
+      map_(config.map),
+      yaw_(rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
+                        config.deskew.imu_yaw_rad)) {}
+
+void Frontend::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) {
+  if (!angular_velocity_imu.allFinite() || !yaw_.add(utime, angular_velocity_imu)) {
+    ++counters_.imu_dropped_time;
+    return;
+  }
+  ++counters_.imu_samples;
+}
+
+std::optional<int64_t> Frontend::last_imu_utime() const {
+  if (yaw_.empty()) return std::nullopt;
+  return yaw_.last_utime();
+}
+
+bool Frontend::imu_active(const Scan& scan) const {
+  // Samples must reach back to the previous pose (or, for the first scan, to its first point)
+  // and be recent.
+  const int64_t from = initialised_ ? last_utime_ : scan.utime_first;
+  return !yaw_.empty() && yaw_.first_utime() <= from &&
+         yaw_.last_utime() + kImuStaleUs >= scan.utime_last;
+}
+
+void Frontend::valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& points_base,
+                            std::vector<int64_t>& utimes) {
+  const std::size_t n = scan.ranges.size();
+  double lo = config_.matcher.min_range_m, hi = config_.matcher.max_range_m;
+  if (std::isfinite(scan.range_min) && scan.range_min > lo) lo = scan.range_min;
+  if (std::isfinite(scan.range_max) && scan.range_max > 0.0 && scan.range_max < hi) hi = scan.range_max;
+  const double duration = static_cast<double>(scan.utime_last - scan.utime_first);
+  points_base.clear();
+  utimes.clear();
+  if (!std::isfinite(scan.angle_first) || !std::isfinite(scan.angle_step)) {
+    counters_.readings_invalid += static_cast<int64_t>(n);
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = scan.ranges[i];
+    if (!std::isfinite(r) || r <= 0.0 || r < lo || r > hi) {
+      ++counters_.readings_invalid;
+      continue;
+    }
+    const double a = scan.angle_first + static_cast<double>(i) * scan.angle_step;
+    points_base.push_back(T_base_laser_ * Eigen::Vector2d(r * std::cos(a), r * std::sin(a)));
+    const double s = n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 1.0;
+    utimes.push_back(scan.utime_first + std::llround(s * duration));
+  }
+}
+
+Pose2 Frontend::predict(int64_t utime, bool use_imu) const {
+  // A scanner's stream: constant velocity over the elapsed time, but over at most twice the last
+  // interval (after a pause it would predict an arbitrarily long step). Scans further apart than
+  // any scanner's period are a log subsampled by travel (the CARMEN sets): their times say little
+  // about the motion, and repeating the last step predicts better.
+  const int64_t elapsed = utime - last_utime_;
+  const int64_t horizon = last_interval_us_ > kMaxStreamIntervalUs
+                              ? last_interval_us_
+                              : std::min(elapsed, 2 * last_interval_us_);
+  Eigen::Vector3d xi = velocity_ * (1e-6 * static_cast<double>(horizon));
+  if (use_imu) xi.z() = yaw_.heading_change(last_utime_, utime);
+  return T_map_base_last_ * Pose2::exp(xi);
+}
+
+void Frontend::deskew(std::vector<Eigen::Vector2d>& points_base, const std::vector<int64_t>& utimes,
+                      int64_t utime_ref, bool use_imu) const {
+  if (!config_.deskew.enabled) return;
+  // Heading change from the IMU's yaw rate, or from the constant angular velocity without IMU.
+  const double omega = velocity_.z();
+  auto heading_change = [&](int64_t t) {
+    return use_imu ? yaw_.heading_change(utime_ref, t)
+                   : omega * 1e-6 * static_cast<double>(t - utime_ref);
+  };
+  deskew_points(points_base, utimes, utime_ref, heading_change, velocity_.head<2>(),
+                config_.deskew.translation);
+}
+
+std::vector<Eigen::Vector2d> Frontend::subsample(const std::vector<Eigen::Vector2d>& points) const {
+  const double spacing = config_.matcher.min_point_spacing_m;
+  if (spacing <= 0.0 || points.empty()) return points;
+  std::vector<Eigen::Vector2d> kept{points.front()};
+  const double spacing2 = spacing * spacing;
+  for (const auto& p : points) {
+    if ((p - kept.back()).squaredNorm() >= spacing2) kept.push_back(p);
+  }
+  return kept;
+}
+
+void Frontend::update_motion(const Pose2& T_map_base, int64_t utime) {
+  if (initialised_) {
+    const double dt = 1e-6 * static_cast<double>(utime - last_utime_);
+    const Eigen::Vector3d v = between(T_map_base_last_, T_map_base).log() / dt;
+    const double alpha = std::min(1.0, dt / kVelocitySmoothingS);
+    velocity_ = alpha * v + (1.0 - alpha) * velocity_;
+    last_interval_us_ = utime - last_utime_;
+  }
+  T_map_base_last_ = T_map_base;
+  last_utime_ = utime;
+}
+
+bool Frontend::map_update_due(const Pose2& T_map_base) const {
+  const Pose2 d = between(T_map_base_last_update_, T_map_base);
+  return d.translation().norm() >= config_.map.update_distance_m ||
+         std::abs(d.theta()) >= config_.map.update_angle_rad;
+}
+
+FrontendResult Frontend::process(const Scan& scan) {
+  ++counters_.scans_received;
+  FrontendResult result;
+  result.utime = scan.utime_last;
+  // Times first: a sweep ending before it starts, or not after the last pose, is dropped.
+  if (scan.utime_last < scan.utime_first || scan.utime_last - scan.utime_first > kMaxSweepUs ||
+      (initialised_ && scan.utime_last <= last_utime_)) {
+    ++counters_.scans_dropped_time;
+    return result;
+  }
+  std::vector<Eigen::Vector2d> points;
+  std::vector<int64_t> utimes;
+  valid_points(scan, points, utimes);
+  result.valid_points = static_cast<int>(points.size());
+  const bool use_imu = imu_active(scan);
+  result.imu_used = use_imu;
+
+  if (static_cast<int>(points.size()) < config_.matcher.min_valid_points) {
+    ++counters_.scans_predicted;
+    result.status = ScanStatus::kPredicted;
+    if (initialised_) {
+      result.T_map_base = predict(scan.utime_last, use_imu);
+      const Eigen::Vector3d prior(std::pow(config_.matcher.prior_sigma_xy_m, 2),
+                                  std::pow(config_.matcher.prior_sigma_xy_m, 2),
+                                  std::pow(config_.matcher.prior_sigma_theta_rad, 2));
+      result.covariance = covariance_last_ + Eigen::Matrix3d(prior.asDiagonal());
+      covariance_last_ = result.covariance;
+      const Eigen::Vector3d velocity = velocity_;
+      update_motion(result.T_map_base, scan.utime_last);
+      velocity_ = velocity;  // a prediction carries no new information about the motion
+    }
+    return result;
+  }
+
+  result.status = ScanStatus::kMatched;
+  if (!initialised_) {
+    // The first scan defines the map frame: the pose is exact by definition.
+    deskew(points, utimes, scan.utime_last, use_imu);
+    result.T_map_base = Pose2();
+    result.covariance = Eigen::Matrix3d::Identity() * 1e-12;
+    result.matched_points = static_cast<int>(points.size());
+  } else {
+    const Pose2 T_pred = predict(scan.utime_last, use_imu);
+    deskew(points, utimes, scan.utime_last, use_imu);
+    // Should the prediction fail, the recovery also searches around the last pose (no motion).
+    std::vector<Pose2> other_centres;
+    if (between(T_pred, T_map_base_last_).translation().norm() > config_.map.resolution_m ||
+        std::abs(between(T_pred, T_map_base_last_).theta()) > 0.01) {
+      other_centres.push_back(T_map_base_last_);
+    }
+    const MatchResult m =
+        match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
+    result.T_map_base = m.T_map_base;
+    result.covariance = m.covariance;
+    result.matched_points = m.points;
+    result.iterations = m.iterations;
+    result.residual_rms = m.residual_rms;
+    result.searched = m.searched;
+    if (m.searched) ++counters_.scans_searched;
+  }
+  ++counters_.scans_matched;
+  covariance_last_ = result.covariance;
+
+  if (!initialised_ || map_update_due(result.T_map_base)) {
+    map_.update(result.T_map_base, T_base_laser_.translation(), points);
+    T_map_base_last_update_ = result.T_map_base;
+    counters_.map_tiles_evicted += static_cast<int64_t>(map_.bound_memory(
+        result.T_map_base.translation(), static_cast<std::size_t>(config_.map.max_bytes)));
+    ++counters_.map_updates;
+    result.map_updated = true;
+  }
+  update_motion(result.T_map_base, scan.utime_last);
+  initialised_ = true;
+  return result;
+}
+
+}  // namespace traverse::frontend

@@ -1,0 +1,114 @@
+// The frontend's per-scan pipeline (seed 000 section 2, Hector SLAM section IV):
+//   1. keep the valid readings of the scan (finite, inside the scanner's and the config's range);
+//   2. predict the pose at the scan's last point by constant velocity (heading change from the
+//      IMU when one is publishing);
+//   3. undo the motion during the sweep: every point is moved into the base frame at the scan's
+//      last point with the heading change at its own time (IMU yaw rate, or the constant
+//      angular velocity without IMU) and, optionally, the constant-velocity translation;
+//   4. match the points against the map pyramid, coarse to fine, from the prediction;
+//   5. update the map when the pose moved or turned past a threshold since the last update.
+// A scan with too few valid points gets the predicted pose (flagged); a scan whose time does not
+// advance, or whose last point is before its first, is dropped. Both are counted.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "frontend_config.hpp"
+#include "scan_matcher.hpp"
+#include "se2.hpp"
+#include "yaw_integrator.hpp"
+
+namespace traverse::frontend {
+
+// One planar sweep, as planar_scan_t carries it. Beam i is measured at
+// utime_first + i (utime_last - utime_first) / (n - 1) along angle_first + i angle_step.
+struct Scan {
+  int64_t utime_first = 0;  // [us]
+  int64_t utime_last = 0;   // [us]
+  double angle_first = 0.0; // [rad] in the laser frame
+  double angle_step = 0.0;  // [rad]
+  double range_min = 0.0;   // [m]
+  double range_max = 0.0;   // [m]
+  std::vector<float> ranges;  // [m]
+};
+
+enum class ScanStatus {
+  kMatched,    // pose measured by matching (the first scan: pose defines the map frame)
+  kPredicted,  // too few valid points: pose predicted from motion
+  kDropped,    // time does not advance or is inconsistent: no pose
+};
+
+struct FrontendResult {
+  ScanStatus status = ScanStatus::kDropped;
+  int64_t utime = 0;  // [us] time the pose is valid at: the scan's last point
+  Pose2 T_map_base;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // (x [m], y [m], theta [rad])
+  bool map_updated = false;
+  bool imu_used = false;
+  int valid_points = 0;
+  int matched_points = 0;
+  int iterations = 0;
+  double residual_rms = 0.0;  // [unitless] RMS of 1 - M at the result
+  bool searched = false;      // the matcher needed its recovery search
+};
+
+struct FrontendCounters {
+  int64_t scans_received = 0;
+  int64_t scans_matched = 0;
+  int64_t scans_predicted = 0;       // too few valid points
+  int64_t scans_searched = 0;        // matches that needed the recovery search
+  int64_t scans_dropped_time = 0;    // time going backwards or utime_last < utime_first
+  int64_t readings_invalid = 0;      // NaN, zero or out-of-range readings ignored
+  int64_t map_updates = 0;
+  int64_t map_tiles_evicted = 0;
+  int64_t imu_samples = 0;
+  int64_t imu_dropped_time = 0;      // IMU samples not after the previous one
+};
+
+class Frontend {
+ public:
+  explicit Frontend(const FrontendConfig& config);
+
+  // Adds an IMU sample: angular velocity [rad/s] in the IMU frame.
+  void add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu);
+  // Time of the newest IMU sample, if any arrived.
+  std::optional<int64_t> last_imu_utime() const;
+
+  FrontendResult process(const Scan& scan);
+
+  const FrontendCounters& counters() const { return counters_; }
+  const MapPyramid& map() const { return map_; }
+  const FrontendConfig& config() const { return config_; }
+
+ private:
+  // Valid readings as points in the base frame with their times; counts invalid ones.
+  void valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& points_base,
+                    std::vector<int64_t>& utimes);
+  bool imu_active(const Scan& scan) const;
+  Pose2 predict(int64_t utime, bool use_imu) const;
+  void deskew(std::vector<Eigen::Vector2d>& points_base, const std::vector<int64_t>& utimes,
+              int64_t utime_ref, bool use_imu) const;
+  std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& points) const;
+  void update_motion(const Pose2& T_map_base, int64_t utime);
+  bool map_update_due(const Pose2& T_map_base) const;
+
+  FrontendConfig config_;
+  Pose2 T_base_laser_;
+  MapPyramid map_;
+  YawIntegrator yaw_;
+  FrontendCounters counters_;
+
+  bool initialised_ = false;
+  int64_t last_utime_ = 0;       // [us] of the last pose
+  int64_t last_interval_us_ = 0; // [us] between the last two poses
+  Pose2 T_map_base_last_;
+  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  // (vx [m/s], vy [m/s], omega [rad/s]) base
+  Pose2 T_map_base_last_update_;
+  Eigen::Matrix3d covariance_last_ = Eigen::Matrix3d::Zero();
+};
+
+}  // namespace traverse::frontend

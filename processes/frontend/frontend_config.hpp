@@ -1,0 +1,131 @@
+// Configuration of the frontend (scan-to-map matcher): one struct per module, defaults here,
+// keys listed once in each `visit`. Lengths m, angles rad, times us.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "channels.hpp"
+
+namespace traverse::frontend {
+
+// Occupancy grid pyramid (Hector SLAM section IV.A, map update section IV.C).
+struct MapConfig {
+  double resolution_m = 0.05;  // finest level; level k has resolution_m * 2^k
+  int levels = 3;              // pyramid depth, 1 = a single grid
+  double p_occupied = 0.9;     // probability an end point's cell is occupied (Hector 0.9)
+  double p_free = 0.4;         // probability a traversed cell is occupied (Hector 0.4)
+  double update_distance_m = 0.2;  // update the map when the pose moved this far ...
+  double update_angle_rad = 0.1;   // ... or turned this much since the last update
+  int64_t max_bytes = 512LL << 20;  // beyond this, tiles farthest from the pose are dropped
+
+  template <class V>
+  void visit(V& v) {
+    v("resolution_m", resolution_m);
+    v("levels", levels);
+    v("p_occupied", p_occupied);
+    v("p_free", p_free);
+    v("update_distance_m", update_distance_m);
+    v("update_angle_rad", update_angle_rad);
+    v("max_bytes", max_bytes);
+  }
+};
+
+// Gauss-Newton scan-to-map matching (Hector SLAM section IV.B).
+struct MatcherConfig {
+  int iterations_coarse = 4;  // Gauss-Newton iterations on every level but the finest
+  int iterations_fine = 6;    // on the finest level
+  // Points closer than this to the previously kept point along the scan are not matched (0 = all).
+  // Fewer points: proportionally faster matching, slightly noisier poses; map updates use all.
+  double min_point_spacing_m = 0.02;
+  int min_valid_points = 20;   // fewer valid readings: the pose is predicted, not measured
+  double min_range_m = 0.1;    // readings outside [min_range_m, max_range_m] are ignored
+  double max_range_m = 40.0;   // (and outside the scan's own range_min/range_max)
+  // Weak prior pulling towards the motion prediction: keeps directions the geometry does not
+  // constrain (a featureless corridor's axis) at the predicted value instead of drifting.
+  double prior_sigma_xy_m = 0.5;
+  double prior_sigma_theta_rad = 0.2;
+  double min_residual_sigma = 0.02;  // floor of the map-value noise used to scale covariances
+  // Recovery: when the RMS of 1 - M after Gauss-Newton exceeds this, the prediction was too far
+  // off for gradient steps (a fast turn between sparse scans): search exhaustively on the
+  // coarsest level within the windows below around the prediction, refine from the best
+  // candidate, keep the better result. 1 or more disables the search.
+  double search_trigger_residual = 0.35;
+  double search_linear_window_m = 1.0;     // +- in x and y
+  double search_angular_window_rad = 0.8;  // +-
+
+  template <class V>
+  void visit(V& v) {
+    v("iterations_coarse", iterations_coarse);
+    v("iterations_fine", iterations_fine);
+    v("min_point_spacing_m", min_point_spacing_m);
+    v("min_valid_points", min_valid_points);
+    v("min_range_m", min_range_m);
+    v("max_range_m", max_range_m);
+    v("prior_sigma_xy_m", prior_sigma_xy_m);
+    v("prior_sigma_theta_rad", prior_sigma_theta_rad);
+    v("min_residual_sigma", min_residual_sigma);
+    v("search_trigger_residual", search_trigger_residual);
+    v("search_linear_window_m", search_linear_window_m);
+    v("search_angular_window_rad", search_angular_window_rad);
+  }
+};
+
+// Motion compensation within a sweep (seed 000 section 2).
+struct DeskewConfig {
+  bool enabled = true;      // rotate each point by the heading change at its own time
+  bool translation = true;  // also shift it by the constant-velocity translation
+  // Orientation of the IMU in the base frame (R_base_imu = Rz(yaw) Ry(pitch) Rx(roll)).
+  double imu_roll_rad = 0.0;
+  double imu_pitch_rad = 0.0;
+  double imu_yaw_rad = 0.0;
+  // A scan waits at most this long (in scan time) for IMU samples covering its last point.
+  int64_t imu_wait_us = 100000;
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled);
+    v("translation", translation);
+    v("imu_roll_rad", imu_roll_rad);
+    v("imu_pitch_rad", imu_pitch_rad);
+    v("imu_yaw_rad", imu_yaw_rad);
+    v("imu_wait_us", imu_wait_us);
+  }
+};
+
+// A planar extrinsic T_parent_child.
+struct Extrinsic2Config {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double theta_rad = 0.0;
+
+  template <class V>
+  void visit(V& v) {
+    v("x_m", x_m);
+    v("y_m", y_m);
+    v("theta_rad", theta_rad);
+  }
+};
+
+struct FrontendConfig {
+  std::string scan_channel = channels::kScanHorizontal;
+  std::string imu_channel = channels::kImu;
+  std::string pose_channel = channels::kPoseFrontend;
+  Extrinsic2Config T_base_laser;
+  MapConfig map;
+  MatcherConfig matcher;
+  DeskewConfig deskew;
+
+  template <class V>
+  void visit(V& v) {
+    v("scan_channel", scan_channel);
+    v("imu_channel", imu_channel);
+    v("pose_channel", pose_channel);
+    v("T_base_laser", T_base_laser);
+    v("map", map);
+    v("matcher", matcher);
+    v("deskew", deskew);
+  }
+};
+
+}  // namespace traverse::frontend

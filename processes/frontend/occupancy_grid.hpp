@@ -1,0 +1,80 @@
+// One level of the frontend's map: a log-odds occupancy grid stored in square tiles that are
+// created on first touch, so the map grows with the area covered and has no edge to run into.
+//
+// Follows Kohlbrecher et al., "A flexible and scalable SLAM system with full 3D motion
+// estimation" (SSRR 2011), section IV.A: the map value M(P) is the occupancy probability of the
+// cell, and a continuous value and its gradient come from bilinear interpolation of the four
+// surrounding cells (eq. 4-6). Cell (i, j) is sampled at (i * resolution, j * resolution) in the
+// map frame. Log-odds are stored as 8-bit integers (1 byte plus 1 byte of update stamp per cell).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+namespace traverse::frontend {
+
+class OccupancyGrid {
+ public:
+  static constexpr int kTileBits = 6;  // 64 x 64 cells per tile
+  static constexpr int kTileSize = 1 << kTileBits;
+  static constexpr int kTileCells = kTileSize * kTileSize;
+
+  // p_occupied / p_free: probability of occupancy given a hit / a traversal (Hector 0.9 / 0.4).
+  OccupancyGrid(double resolution_m, double p_occupied, double p_free);
+
+  double resolution() const { return resolution_m_; }
+
+  // Occupancy probability of one cell; 0.5 where nothing was observed.
+  double cell_probability(int64_t ix, int64_t iy) const;
+
+  // M(p) by bilinear interpolation (eq. 4) and, if `gradient` is given, dM/dp [1/m] (eq. 5-6).
+  double value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient = nullptr) const;
+
+  // Integrates one scan seen from `origin_map`: cells on each ray become more likely free, the end
+  // point's cell more likely occupied. Each cell is updated at most once per call and a hit wins
+  // over a traversal. `incidence_sin` (optional, one per hit) is |sin| of the angle between the
+  // beam and the surface it hit: a beam grazing a wall runs within a cell of the wall for
+  // resolution / sin metres before its end, so the free-space update stops that far short (else
+  // grazing beams of later scans erase the wall cells that earlier scans saw).
+  void update(const Eigen::Vector2d& origin_map, const std::vector<Eigen::Vector2d>& hits_map,
+              const std::vector<double>* incidence_sin = nullptr);
+
+  // Bytes held by the cells (tiles x tile size); the map's memory use to report.
+  std::size_t memory_bytes() const { return tiles_.size() * sizeof(Tile); }
+  std::size_t tile_count() const { return tiles_.size(); }
+  // Extent of the observed area [m]: min and max corner of all tiles, zero if empty.
+  Eigen::Vector2d min_corner() const;
+  Eigen::Vector2d max_corner() const;
+
+  // Drops the tiles farthest from `p_map` until memory_bytes() <= max_bytes. Returns tiles dropped.
+  std::size_t evict_farthest(const Eigen::Vector2d& p_map, std::size_t max_bytes);
+
+ private:
+  struct Tile {
+    std::array<int8_t, kTileCells> log_odds{};  // in steps of kLogOddsStep
+    std::array<uint8_t, kTileCells> stamp{};    // update() call that last touched the cell
+  };
+  static uint64_t tile_key(int64_t tx, int64_t ty);
+  const Tile* find_tile(int64_t tx, int64_t ty) const;
+  Tile& tile_at(int64_t tx, int64_t ty);
+  // Applies `delta` to cell (ix, iy) unless this update already touched it.
+  void touch(int64_t ix, int64_t iy, int delta);
+  void trace_free(int64_t x0, int64_t y0, int64_t x1, int64_t y1);
+
+  double resolution_m_;
+  int occupied_delta_;
+  int free_delta_;
+  std::array<float, 256> probability_of_{};  // indexed by log-odds + 128
+  std::unordered_map<uint64_t, std::unique_ptr<Tile>> tiles_;
+  uint8_t stamp_ = 0;
+  // One-entry cache of the last tile looked up: consecutive look-ups mostly hit the same tile.
+  mutable uint64_t cached_key_ = ~0ULL;
+  mutable Tile* cached_tile_ = nullptr;
+};
+
+}  // namespace traverse::frontend

@@ -1,0 +1,84 @@
+// Scan-to-map matching by Gauss-Newton on a multi-resolution occupancy grid pyramid.
+//
+// Follows Kohlbrecher et al. 2011 (Hector SLAM), section IV.B: find the pose xi = (x, y, psi)
+// that minimises sum_i (1 - M(S_i(xi)))^2, where S_i are the scan end points moved by xi (eq. 7)
+// and M the bilinearly interpolated map value. Linearising M(S_i(xi + dxi)) gives the step
+// dxi = H^-1 sum_i [grad M dS_i/dxi]^T (1 - M(S_i(xi))) with H = sum_i [grad M dS_i/dxi]^T
+// [grad M dS_i/dxi] (eq. 10-13). Section IV.D: start on the coarsest grid, each finer grid starts
+// from the coarser result. Added to the paper: a weak prior towards the motion prediction, so
+// directions the geometry leaves free keep the predicted value, and a step that raises the cost
+// is halved instead of taken.
+//
+// Recovery (not in the paper): when the residual after Gauss-Newton says the match failed, an
+// exhaustive search over a window of poses on the coarsest grid (scoring occupied evidence under
+// the points, as correlative matching does, Olson 2009) gives a new start for Gauss-Newton.
+//
+// Covariance: residuals 1 - M are unitless; with the map-value noise sigma^2 estimated from the
+// final residuals (sum r^2 / (n - 3), floored), the information of the pose is H / sigma^2 + P,
+// where H is in 1/m^2 (translation) and 1/rad^2 (rotation) because the gradient is taken per
+// metre, and P is the prior's information. Several points falling into one cell do not observe
+// independent map noise, so H is divided by (points / distinct cells). The covariance is the
+// inverse of that information, in m^2, m rad, rad^2.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+#include "frontend_config.hpp"
+#include "occupancy_grid.hpp"
+#include "se2.hpp"
+
+namespace traverse::frontend {
+
+// Grids of resolution r, 2r, 4r, ... (level 0 is the finest), all updated with every scan.
+class MapPyramid {
+ public:
+  explicit MapPyramid(const MapConfig& config);
+  int levels() const { return static_cast<int>(grids_.size()); }
+  const OccupancyGrid& level(int k) const { return grids_[k]; }
+  // Integrates a scan: hits in the base frame, seen from T_map_base * origin_base.
+  void update(const Pose2& T_map_base, const Eigen::Vector2d& origin_base,
+              const std::vector<Eigen::Vector2d>& hits_base);
+  std::size_t memory_bytes() const;
+  // Drops far tiles (all levels) so the total stays under max_bytes. Returns tiles dropped.
+  std::size_t bound_memory(const Eigen::Vector2d& p_map, std::size_t max_bytes);
+
+ private:
+  std::vector<OccupancyGrid> grids_;
+};
+
+struct MatchResult {
+  Pose2 T_map_base;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of (x [m], y [m], theta [rad])
+  int iterations = 0;          // Gauss-Newton steps over all levels
+  int points = 0;              // points matched
+  double residual_rms = 0.0;   // RMS of 1 - M at the result, finest level [unitless]
+  bool searched = false;       // the recovery search ran (and its result was kept)
+};
+
+// Estimated map-value cost and derivatives of one pose, used by the matcher and by tests.
+struct NormalEquations {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();  // sum J^T J [1/m^2, 1/(m rad), 1/rad^2]
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();  // sum J^T r
+  double cost = 0.0;                            // sum r^2
+  int n = 0;
+};
+NormalEquations normal_equations(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+                                 const Pose2& T_map_base);
+
+// Best pose within +-linear_window_m (x, y) and +-angular_window_rad of T_center by exhaustive
+// search on `grid` (steps of one cell, and of the angle that moves the farthest point one cell).
+Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+                  const Pose2& T_center, double linear_window_m, double angular_window_rad);
+
+// Matches points (base frame) against the pyramid from T_map_base_predicted. `first_level` and
+// `last_level` select the pyramid levels used, coarse to fine (defaults: all). When the result's
+// residual exceeds config.search_trigger_residual, searches around the prediction and around
+// each of `other_centres` (e.g. the last pose: no motion), refines each, keeps the best.
+MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
+                       const Pose2& T_map_base_predicted, const MatcherConfig& config,
+                       int first_level = -1, int last_level = 0,
+                       const std::vector<Pose2>& other_centres = {});
+
+}  // namespace traverse::frontend

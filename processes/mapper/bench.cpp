@@ -1,0 +1,159 @@
+// traverse-mapper-bench: speed of the Mapper on simulated profiles (one core), against plain
+// OcTree::insertPointCloud on the same points in the same run. Simulates the route first (not
+// timed), places the profiles with the true trajectory at 2 cm and 5 cm, times a loop closure
+// that moves the second half of the trajectory, and prints one JSON object last.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+
+#include "config.hpp"
+#include "mapper.hpp"
+#include "simulator.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+namespace tm = traverse::mapper;
+namespace ts = traverse::sim;
+
+struct Run {
+  double mapper_s = 0, octomap_s = 0, move_s = 0;
+  int64_t points = 0, octomap_points = 0, moved_profiles = 0;
+  std::size_t voxels = 0, profile_bytes = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("traverse-mapper-bench: Mapper points per second vs OcTree::insertPointCloud");
+  std::string world_file = "configs/worlds/office.yaml", route_file = "configs/routes/office-x2.yaml";
+  std::string rig_file = "configs/rig.yaml";
+  double duration_s = 60, begin_s = 10, baseline_s = 2;
+  app.add_option("--world", world_file);
+  app.add_option("--route", route_file);
+  app.add_option("--rig", rig_file);
+  app.add_option("--duration", duration_s, "[s] of profiles");
+  app.add_option("--begin", begin_s, "[s] into the route");
+  app.add_option("--baseline", baseline_s, "[s] of profiles given to insertPointCloud");
+  CLI11_PARSE(app, argc, argv);
+
+  ts::WorldSpec world;
+  ts::RouteSpec route;
+  ts::RigConfig rig;
+  traverse::load_config(world_file, world);
+  traverse::load_config(route_file, route);
+  traverse::load_config(rig_file, rig);
+  ts::RunOptions opt;
+  opt.begin_s = begin_s;
+  opt.duration_s = duration_s;
+  ts::Simulator sim(world, route, rig, ts::PlatformConfig{}, 1, 1'700'000'000'000'000, opt);
+  std::vector<tm::Profile> profiles;
+  std::vector<int64_t> gt_t;
+  std::vector<traverse::Pose2> gt;
+  const auto t_sim = Clock::now();
+  while (auto e = sim.next()) {
+    if (e->kind == ts::SimEvent::Kind::kGroundTruth) {
+      gt_t.push_back(e->utime);
+      gt.push_back(e->ground_truth.T_world_base);
+    } else if (e->kind == ts::SimEvent::Kind::kScanProfile) {
+      const ts::ScanData& s = e->scan;
+      profiles.push_back({s.utime_first, s.utime_last, s.angle_first, s.angle_step, s.ranges,
+                          s.intensities});
+    }
+  }
+  std::fprintf(stderr, "simulated %.0f s: %zu profiles, %zu true poses in %.1f s\n", duration_s,
+               profiles.size(), gt.size(), seconds_since(t_sim));
+  // The true trajectory in segments of 40 poses (0.2 s), as the densifier would send them.
+  auto segments = [&](double shift_y, std::size_t from) {
+    std::vector<tm::TrajectorySegment> out;
+    for (std::size_t i = 0; i + 1 < gt.size(); i += 40) {
+      tm::TrajectorySegment s;
+      s.key_id_first = static_cast<int64_t>(out.size());
+      for (std::size_t j = i; j <= std::min(i + 40, gt.size() - 1); ++j) {
+        s.utimes.push_back(gt_t[j]);
+        const double dy = i >= from ? shift_y : 0.0;
+        s.T_world_base.emplace_back(gt[j].x(), gt[j].y() + dy, gt[j].theta());
+      }
+      if (s.utimes.size() >= 2) out.push_back(s);
+    }
+    return out;
+  };
+  const auto base_segments = segments(0, 0);
+  const auto moved_segments = segments(0.05, gt.size() / 2);
+  int64_t beams = 0;
+  for (const auto& p : profiles) beams += static_cast<int64_t>(p.ranges.size());
+  const Eigen::Isometry3d T_base_laser = rig.laser_profile.transform();
+
+  Run runs[2];
+  const double resolutions[2] = {0.02, 0.05};
+  for (int r = 0; r < 2; ++r) {
+    tm::MapperConfig cfg;
+    cfg.resolution_m = resolutions[r];
+    tm::Mapper mapper(cfg, T_base_laser);
+    for (const auto& s : base_segments) mapper.set_segment(s);
+    auto t0 = Clock::now();
+    for (const auto& p : profiles) mapper.add_profile(p);
+    runs[r].mapper_s = seconds_since(t0);
+    runs[r].points = mapper.points();
+    runs[r].voxels = mapper.occupied_voxels();
+    runs[r].profile_bytes = mapper.profile_bytes();
+    // The same points, profile by profile, through plain insertPointCloud (rays from the laser).
+    octomap::OcTree tree(resolutions[r]);
+    std::vector<octomap::Pointcloud> clouds(profiles.size());
+    std::size_t k = 0;
+    mapper.for_each_point([&](const tm::CloudPoint& p) {
+      while (k + 1 < profiles.size() && p.utime > profiles[k].utime_last) ++k;
+      clouds[k].push_back(p.p_world.x(), p.p_world.y(), p.p_world.z());
+    });
+    const int64_t t_end = profiles.front().utime_first + static_cast<int64_t>(baseline_s * 1e6);
+    t0 = Clock::now();
+    for (std::size_t i = 0; i < profiles.size() && profiles[i].utime_last <= t_end; ++i) {
+      const int64_t t_mid = (profiles[i].utime_first + profiles[i].utime_last) / 2;
+      auto it = std::lower_bound(gt_t.begin(), gt_t.end(), t_mid);
+      const traverse::Pose2& T = gt[static_cast<std::size_t>(it - gt_t.begin())];
+      const Eigen::Vector2d o = T * Eigen::Vector2d(T_base_laser.translation().head<2>());
+      tree.insertPointCloud(clouds[i], octomap::point3d(o.x(), o.y(), T_base_laser.translation().z()));
+      runs[r].octomap_points += static_cast<int64_t>(clouds[i].size());
+    }
+    runs[r].octomap_s = seconds_since(t0);
+    // A loop closure moves the second half of the trajectory by 5 cm.
+    t0 = Clock::now();
+    for (const auto& s : moved_segments) mapper.set_segment(s);
+    runs[r].moved_profiles = static_cast<int64_t>(mapper.apply_moves());
+    runs[r].move_s = seconds_since(t0);
+  }
+  const double span_s = 1e-6 * static_cast<double>(profiles.back().utime_last - profiles.front().utime_first);
+  double pps[2], octo[2], ratio[2];
+  for (int r = 0; r < 2; ++r) {
+    pps[r] = runs[r].points / runs[r].mapper_s;
+    octo[r] = runs[r].octomap_points / runs[r].octomap_s;
+    ratio[r] = pps[r] / octo[r];
+    std::printf(
+        "%.0f cm: mapper %.0f points/s (%.0f beams/s, %lld points in %.2f s); insertPointCloud "
+        "%.0f points/s (%lld points of the first %.1f s in %.2f s); ratio %.1f; %zu occupied "
+        "voxels; moving %lld profiles (5 cm loop closure) took %.2f s\n",
+        100 * resolutions[r], pps[r], beams / runs[r].mapper_s,
+        static_cast<long long>(runs[r].points), runs[r].mapper_s, octo[r],
+        static_cast<long long>(runs[r].octomap_points), baseline_s, runs[r].octomap_s, ratio[r],
+        runs[r].voxels, static_cast<long long>(runs[r].moved_profiles), runs[r].move_s);
+  }
+  const double bytes_per_s = runs[0].profile_bytes / span_s;
+  std::printf("stored profiles: %.2f MB per s of data -> %.2f GB for a 30-minute session\n",
+              bytes_per_s / 1e6, bytes_per_s * 1800 / 1e9);
+  std::printf(
+      "{\"bench\": \"mapper\", \"route\": \"%s\", \"profiles\": %zu, \"data_s\": %.2f, "
+      "\"beams\": %lld, \"points_per_s_2cm\": %.0f, \"points_per_s_5cm\": %.0f, "
+      "\"beams_per_s_2cm\": %.0f, \"beams_per_s_5cm\": %.0f, \"octomap_points_per_s_2cm\": %.0f, "
+      "\"octomap_points_per_s_5cm\": %.0f, \"ratio_to_octomap_2cm\": %.2f, "
+      "\"ratio_to_octomap_5cm\": %.2f, \"octomap_baseline_s\": %.1f, \"move_s_2cm\": %.3f, "
+      "\"moved_profiles\": %lld, \"profile_bytes_per_s\": %.0f, \"keeps_up_244k\": %s}\n",
+      route_file.c_str(), profiles.size(), span_s, static_cast<long long>(beams), pps[0], pps[1],
+      beams / runs[0].mapper_s, beams / runs[1].mapper_s, octo[0], octo[1], ratio[0], ratio[1],
+      baseline_s, runs[0].move_s, static_cast<long long>(runs[0].moved_profiles), bytes_per_s,
+      beams / runs[0].mapper_s >= 244000 && beams / runs[1].mapper_s >= 244000 ? "true" : "false");
+  return 0;
+}

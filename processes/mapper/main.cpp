@@ -1,0 +1,60 @@
+// traverse-mapper: places every point of the tilted profile scanner with the corrected trajectory
+// at its own time, into an OctoMap and a full-density cloud that follow loop closures. Exports
+// cloud.ply, map.bt and map.ot into the output folder on SIGUSR1 and at shutdown.
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <csignal>
+
+#include "mapper_node.hpp"
+#include "process.hpp"
+#include "rig.hpp"
+
+namespace {
+std::atomic<bool> g_export_requested{false};
+void on_usr1(int) { g_export_requested = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  traverse::Process proc("mapper",
+                         "3D mapper: tilted profiles -> OctoMap and point cloud that follow loop "
+                         "closures; exports on SIGUSR1 and at shutdown");
+  traverse::mapper::MapperConfig config;
+  if (auto rc = proc.start(argc, argv, config)) return *rc;
+  traverse::sim::RigConfig rig;
+  try {
+    traverse::load_config(config.rig_file, rig);
+  } catch (const traverse::ConfigError& e) {
+    spdlog::error("{} (rig_file of {})", e.what(), proc.config_path());
+    return traverse::kConfigErrorExitCode;
+  }
+  if (config.resolution_m <= 0 || config.range_max_m <= config.range_min_m ||
+      config.poses_per_segment < 1) {
+    spdlog::error("{}: need resolution_m > 0, range_max_m > range_min_m, poses_per_segment >= 1",
+                  proc.config_path());
+    return traverse::kConfigErrorExitCode;
+  }
+  std::signal(SIGUSR1, on_usr1);
+  traverse::mapper::MapperNode node(
+      proc.bus(), config, rig.laser_profile.transform(),
+      [&proc](const std::string& name, double v) { proc.counter(name) = v; });
+  auto do_export = [&node, &config] {
+    std::string error;
+    if (node.export_all(&error)) {
+      spdlog::info("mapper: exported {} points to {}", node.mapper().placed_points(),
+                   config.output_dir);
+    } else {
+      spdlog::error("mapper: export failed: {}", error);
+    }
+  };
+  const int rc = proc.spin([&] {
+    node.tick();
+    node.report_counters();
+    if (g_export_requested.exchange(false)) do_export();
+  });
+  node.finish();
+  do_export();
+  node.report_counters();
+  proc.publish_status("stopped");
+  return rc;
+}

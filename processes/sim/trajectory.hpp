@@ -1,0 +1,125 @@
+// The platform's true motion: a cart pushed along a route of waypoints. Between waypoints it
+// drives straight with a trapezoidal speed profile (accelerate, cruise, brake to a stop); at each
+// waypoint it turns on the spot with a trapezoidal yaw-rate profile; it may pause. On top of the
+// nominal motion the cart vibrates: each vibration component is a sinusoid whose phase advances
+// with the distance rolled by the wheels (wheel out-of-roundness, floor tiles), so its frequency
+// follows the speed and it dies out when the cart stands still. The ground truth is the nominal
+// pose composed with the vibration, evaluated exactly at any time.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rng.hpp"
+#include "se2.hpp"
+
+namespace traverse::sim {
+
+// configs/routes/*.yaml
+struct RouteSpec {
+  std::string world;                                // world name, must match the world file's name
+  std::string horizontal_scanner = "focus3d_120s";  // rig model: focus3d_120s or focus3d_x330
+  double speed_mps = 0.5;                           // [m/s] cruise speed on straight legs
+  std::vector<std::vector<double>> waypoints;       // [m] [[x, y], ...] in world, 2+ points
+  double start_heading_rad = 1e9;  // [rad] initial heading; default: towards waypoint 1
+  double start_pause_s = 2.0;      // [s] standing still before moving (IMU settles)
+  double end_pause_s = 2.0;        // [s] standing still at the end
+  std::vector<int> stop_at;        // waypoint indices where the cart also pauses
+  double stop_s = 3.0;             // [s] length of those pauses
+  template <class V>
+  void visit(V& v) {
+    v("world", world);
+    v("horizontal_scanner", horizontal_scanner);
+    v("speed_mps", speed_mps);
+    v("waypoints", waypoints);
+    v("start_heading_rad", start_heading_rad);
+    v("start_pause_s", start_pause_s);
+    v("end_pause_s", end_pause_s);
+    v("stop_at", stop_at);
+    v("stop_s", stop_s);
+  }
+};
+
+// One vibration component, added in the base frame.
+struct VibrationSpec {
+  std::string axis = "y";     // x (along), y (across) [m] or yaw [rad]
+  double amplitude = 0.001;   // [m] or [rad] at reference speed and above
+  double wavelength_m = 0.6;  // [m] of wheel travel per cycle
+  template <class V>
+  void visit(V& v) {
+    v("axis", axis);
+    v("amplitude", amplitude);
+    v("wavelength_m", wavelength_m);
+  }
+};
+
+struct PlatformConfig {
+  double accel_mps2 = 0.4;        // [m/s^2] speeding up and braking on straight legs
+  double yaw_rate_radps = 0.6;    // [rad/s] turning on the spot
+  double yaw_accel_radps2 = 0.8;  // [rad/s^2]
+  double half_track_m = 0.25;     // [m] wheel distance from the centre (wheel travel in turns)
+  double vibration_ref_speed_mps =
+      0.3;  // [m/s] wheel speed at which vibration is at full amplitude
+  std::vector<VibrationSpec> vibration = {
+      {"y", 0.002, 0.63},    // 2 mm sway per wheel turn (0.2 m wheel, slightly out of round)
+      {"yaw", 0.002, 0.63},  // 2 mrad yaw wobble per wheel turn
+      {"x", 0.001, 0.30},    // 1 mm surge on 0.3 m floor tile joints
+      {"y", 0.0005, 0.05},   // 0.5 mm chatter on floor roughness (10 Hz at 0.5 m/s)
+      {"yaw", 0.0005, 0.05}};
+  template <class V>
+  void visit(V& v) {
+    v("accel_mps2", accel_mps2);
+    v("yaw_rate_radps", yaw_rate_radps);
+    v("yaw_accel_radps2", yaw_accel_radps2);
+    v("half_track_m", half_track_m);
+    v("vibration_ref_speed_mps", vibration_ref_speed_mps);
+    v("vibration", vibration);
+  }
+};
+
+class Trajectory {
+ public:
+  // Throws std::runtime_error for an unusable route (fewer than 2 waypoints, bad speed).
+  // `rng` draws the vibration phases.
+  Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng);
+
+  double duration_s() const { return segments_.empty() ? 0.0 : segments_.back().t1; }
+  double length_m() const { return length_m_; }  // [m] driven on straight legs
+
+  // True pose T_world_base at t [s] since the start (clamped to [0, duration]).
+  Pose2 pose(double t) const;
+  // Nominal pose without vibration.
+  Pose2 nominal_pose(double t) const;
+
+ private:
+  enum class Kind { kPause, kLine, kTurn };
+  struct Segment {
+    Kind kind;
+    double t0, t1;       // [s]
+    Pose2 start;         // nominal pose at t0
+    double amount;       // [m] length (line) or [rad] signed angle (turn)
+    double vmax, accel;  // [m/s, m/s^2] or [rad/s, rad/s^2]
+    double dist0;        // [m] wheel travel before t0
+  };
+  struct State {
+    Pose2 pose;
+    double dist;         // [m] wheel travel
+    double wheel_speed;  // [m/s]
+  };
+  State nominal_state(double t) const;
+  void add(Kind kind, const Pose2& start, double amount, double vmax, double accel);
+
+  std::vector<Segment> segments_;
+  PlatformConfig platform_;
+  std::vector<double> phases_;
+  std::vector<int> axes_;  // 0 x, 1 y, 2 yaw per vibration component
+  double length_m_ = 0.0;
+  double dist_ = 0.0;
+};
+
+// Trapezoidal profile over `amount` (>= 0) with top rate vmax and acceleration a: duration and
+// the travelled amount and rate at time tau.
+double trapezoid_duration(double amount, double vmax, double a);
+void trapezoid_at(double amount, double vmax, double a, double tau, double& s, double& v);
+
+}  // namespace traverse::sim

@@ -1,0 +1,193 @@
+#include "report.hpp"
+
+#include <cstdio>
+
+namespace traverse::validate {
+namespace {
+
+std::string format(const char* fmt, auto... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof(buf), fmt, args...);
+  return buf;
+}
+
+std::string number_or_dash(const std::optional<double>& v, const char* fmt) {
+  return v ? format(fmt, *v) : "-";
+}
+
+std::string short_type(const std::string& type) {
+  const auto dot = type.rfind('.');
+  return type.empty() ? "?" : type.substr(dot == std::string::npos ? 0 : dot + 1);
+}
+
+}  // namespace
+
+std::vector<std::string> channel_problems(const ChannelSummaries& channels) {
+  std::vector<std::string> out;
+  for (const auto& [name, c] : channels) {
+    if (c.decode_failures > 0) {
+      out.push_back(name + ": " + std::to_string(c.decode_failures) + " of " +
+                    std::to_string(c.count) + " messages do not decode as " +
+                    (c.type.empty() ? std::string("any known type") : c.type));
+    }
+    if (c.backwards > 0) {
+      out.push_back(name + ": timestamps go backwards at " + std::to_string(c.backwards) +
+                    " messages (event time " + std::to_string(c.event_backwards) +
+                    ", message utime " + std::to_string(c.utime_backwards) + ", up to " +
+                    format("%.6f", c.max_backstep_s.value_or(0.0)) + " s)");
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> process_problems(const ProcessSummaries& processes) {
+  std::vector<std::string> out;
+  for (const auto& [name, p] : processes) {
+    if (p.state == "silent") {
+      out.push_back(name + ": silent for " + format("%.1f", p.silent_s) + " s");
+    }
+    if (p.last.decode_failures > 0) {
+      out.push_back(name + ": reports " + std::to_string(p.last.decode_failures) +
+                    " decode failures");
+    }
+    if (p.last.handler_errors > 0) {
+      out.push_back(name + ": reports " + std::to_string(p.last.handler_errors) +
+                    " handler errors");
+    }
+  }
+  return out;
+}
+
+void write_channels(JsonWriter& json, const ChannelSummaries& channels) {
+  json.key("channels").begin_object();
+  for (const auto& [name, c] : channels) {
+    json.key(name).begin_object();
+    json.field("type", c.type.empty() ? std::optional<std::string>() : c.type);
+    json.field("count", c.count);
+    json.field("rate_hz", c.rate_hz);
+    json.field("max_gap_s", c.max_gap_s);
+    json.field("backwards", c.backwards);
+    json.field("event_backwards", c.event_backwards);
+    json.field("utime_backwards", c.utime_backwards);
+    json.field("max_backstep_s", c.max_backstep_s);
+    json.field("seq_gaps", c.seq_gaps);
+    json.field("seq_restarts", c.seq_restarts);
+    json.field("decode_failures", c.decode_failures);
+    json.field("unknown_fingerprint", c.unknown_fingerprint);
+    json.field("undecodable", c.undecodable);
+    json.key("other_types").begin_object();
+    for (const auto& [type, n] : c.other_types) json.field(type, n);
+    json.end_object();
+    auto opt = [](const Range& r, int64_t v) { return r.empty ? std::optional<int64_t>() : v; };
+    json.field("points_per_scan_min", opt(c.points, c.points.min));
+    json.field("points_per_scan_max", opt(c.points, c.points.max));
+    auto secs = [](const Range& r, int64_t v) {
+      return r.empty ? std::optional<double>() : 1e-6 * static_cast<double>(v);
+    };
+    json.field("sweep_s_min", secs(c.sweep_us, c.sweep_us.min));
+    json.field("sweep_s_max", secs(c.sweep_us, c.sweep_us.max));
+    json.field("period_s", c.period_s);
+    json.key("frames").begin_array();
+    for (const auto& f : c.frames) json.value(f);
+    json.end_array();
+    json.field("first_utime", c.first_event_utime);
+    json.field("last_utime", c.last_event_utime);
+    json.end_object();
+  }
+  json.end_object();
+}
+
+void write_processes(JsonWriter& json, const ProcessSummaries& processes) {
+  json.key("processes").begin_object();
+  for (const auto& [name, p] : processes) {
+    json.key(name).begin_object();
+    json.field("channel", p.channel);
+    json.field("state", p.state);
+    json.field("last_state", p.last.state);
+    json.field("host", p.last.host);
+    json.field("pid", static_cast<int64_t>(p.last.pid));
+    json.field("statuses", p.statuses);
+    json.field("silent_s", p.silent_s);
+    json.field("max_status_gap_s", p.max_status_gap_s);
+    json.field("status_seq_gaps", p.status_seq_gaps);
+    json.field("restarts", p.restarts);
+    json.field("uptime_s", p.last.uptime_s);
+    json.field("cpu_s", p.last.cpu_s);
+    json.field("rss_bytes", p.last.rss_bytes);
+    json.field("peak_rss_bytes", p.peak_rss_bytes);
+    json.field("received", p.last.received);
+    json.field("published", p.last.published);
+    json.field("decode_failures", p.last.decode_failures);
+    json.field("out_of_order", p.last.out_of_order);
+    json.field("missed", p.last.missed);
+    json.field("handler_errors", p.last.handler_errors);
+    json.end_object();
+  }
+  json.end_object();
+}
+
+void write_problems(JsonWriter& json, const std::vector<std::string>& problems) {
+  json.key("problems").begin_array();
+  for (const auto& p : problems) json.value(p);
+  json.end_array();
+}
+
+std::string channel_table(const ChannelSummaries& channels) {
+  std::string out =
+      format("%-24s %-18s %9s %10s %11s %9s %8s %11s %13s\n", "channel", "type", "count",
+             "rate [Hz]", "max gap [s]", "backwards", "seq gaps", "decode fail", "points/scan");
+  for (const auto& [name, c] : channels) {
+    const std::string points = c.points.empty
+                                   ? "-"
+                                   : format("%lld..%lld", static_cast<long long>(c.points.min),
+                                            static_cast<long long>(c.points.max));
+    out += format("%-24s %-18s %9lld %10s %11s %9lld %8lld %11lld %13s\n", name.c_str(),
+                  short_type(c.type).c_str(), static_cast<long long>(c.count),
+                  number_or_dash(c.rate_hz, "%.3f").c_str(),
+                  number_or_dash(c.max_gap_s, "%.3f").c_str(), static_cast<long long>(c.backwards),
+                  static_cast<long long>(c.seq_gaps), static_cast<long long>(c.decode_failures),
+                  points.c_str());
+    std::string details;
+    if (c.period_s) details += format("  period %.4f s", *c.period_s);
+    if (!c.sweep_us.empty) {
+      details += format("  sweep %.4f..%.4f s", 1e-6 * static_cast<double>(c.sweep_us.min),
+                        1e-6 * static_cast<double>(c.sweep_us.max));
+    }
+    if (!c.frames.empty()) {
+      details += "  frames";
+      for (const auto& f : c.frames) details += " " + f;
+    }
+    if (c.max_backstep_s) details += format("  steps back up to %.6f s", *c.max_backstep_s);
+    if (c.unknown_fingerprint > 0) {
+      details += format("  %lld of unknown type", static_cast<long long>(c.unknown_fingerprint));
+    }
+    if (c.undecodable > 0) {
+      details += format("  %lld undecodable", static_cast<long long>(c.undecodable));
+    }
+    for (const auto& [type, n] : c.other_types) {
+      details += format("  %lld as %s", static_cast<long long>(n), type.c_str());
+    }
+    if (c.seq_restarts > 0) {
+      details += format("  %lld seq restarts", static_cast<long long>(c.seq_restarts));
+    }
+    if (!details.empty()) out += "   " + details + "\n";
+  }
+  return out;
+}
+
+std::string process_table(const ProcessSummaries& processes) {
+  std::string out =
+      format("%-20s %-10s %9s %11s %14s %9s %10s %11s %9s\n", "process", "state", "statuses",
+             "silent [s]", "max gap [s]", "cpu [s]", "rss [MB]", "decode fail", "handler err");
+  for (const auto& [name, p] : processes) {
+    out += format("%-20s %-10s %9lld %11.1f %14s %9.2f %10.1f %11lld %9lld\n", name.c_str(),
+                  p.state.c_str(), static_cast<long long>(p.statuses), p.silent_s,
+                  number_or_dash(p.max_status_gap_s, "%.2f").c_str(), p.last.cpu_s,
+                  1e-6 * static_cast<double>(p.last.rss_bytes),
+                  static_cast<long long>(p.last.decode_failures),
+                  static_cast<long long>(p.last.handler_errors));
+  }
+  return out;
+}
+
+}  // namespace traverse::validate

@@ -1,0 +1,35 @@
+// Turns stream and process summaries into what the tools print: a table for people, one JSON
+// object for scripts, and the list of problems that make a log or a run not ok.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "json_writer.hpp"
+#include "process_tracker.hpp"
+#include "stream_analyzer.hpp"
+
+namespace traverse::validate {
+
+using ChannelSummaries = std::map<std::string, ChannelSummary>;
+using ProcessSummaries = std::map<std::string, ProcessSummary>;
+
+// One sentence per problem: decode failures and timestamps going backwards on a channel.
+std::vector<std::string> channel_problems(const ChannelSummaries& channels);
+// One sentence per problem: silent processes, and decode failures or handler errors a process
+// reports in its status.
+std::vector<std::string> process_problems(const ProcessSummaries& processes);
+
+// Writes the key "channels" and an object with one entry per channel.
+void write_channels(JsonWriter& json, const ChannelSummaries& channels);
+// Writes the key "processes" and an object with one entry per process.
+void write_processes(JsonWriter& json, const ProcessSummaries& processes);
+// Writes the key "problems" and the list.
+void write_problems(JsonWriter& json, const std::vector<std::string>& problems);
+
+// Human-readable tables, one line per channel or process (plus detail lines), ending in '\n'.
+std::string channel_table(const ChannelSummaries& channels);
+std::string process_table(const ProcessSummaries& processes);
+
+}  // namespace traverse::validate

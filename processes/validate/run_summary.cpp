@@ -1,0 +1,42 @@
+#include "run_summary.hpp"
+
+namespace traverse::validate {
+
+void judge(RunSummary& s) {
+  s.problems = channel_problems(s.channels);
+  for (auto& p : process_problems(s.processes)) s.problems.push_back(std::move(p));
+  if (s.status_decode_failures > 0) {
+    s.problems.push_back(std::to_string(s.status_decode_failures) +
+                         " messages on STATUS_ channels are not a process status");
+  }
+  s.ok = s.problems.empty();
+}
+
+std::string to_json(const RunSummary& s) {
+  JsonWriter json;
+  json.begin_object();
+  json.field("lcm_url", s.lcm_url);
+  json.field("start_utime", s.start_utime);
+  json.field("end_utime", s.end_utime);
+  json.field("duration_s", 1e-6 * static_cast<double>(s.end_utime - s.start_utime));
+  json.field("events", s.events);
+  json.field("status_decode_failures", s.status_decode_failures);
+  write_channels(json, s.channels);
+  write_processes(json, s.processes);
+  write_problems(json, s.problems);
+  json.field("ok", s.ok);
+  json.end_object();
+  return json.str();
+}
+
+std::string to_text(const RunSummary& s) {
+  std::string out = "heard " + std::to_string(s.events) + " messages on " +
+                    std::to_string(s.channels.size()) + " channels from " +
+                    std::to_string(s.processes.size()) + " processes\n\n";
+  out += channel_table(s.channels) + "\n" + process_table(s.processes) + "\n";
+  for (const auto& p : s.problems) out += "problem: " + p + "\n";
+  out += s.ok ? "run is clean\n" : "run has problems\n";
+  return out;
+}
+
+}  // namespace traverse::validate

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# scripts/eval-carmen.sh NAME|PATH [--stages LIST] [--speed S]
+#
+# One command per evaluation on a real CARMEN log: converts ../shared/data/carmen/NAME-corrected.log.gz
+# (or any CARMEN log PATH) with traverse-carmen (cached as out/cache/carmen-NAME.lcmlog,
+# reconverted when the program or the input is newer), runs the named stages of the graph on it
+# (scripts/run-graph.sh, configs/deploy/pipeline.yaml), and evaluates the last stage's trajectory
+# against the log's reference poses (POSE_REFERENCE: the corrected trajectory of an established
+# SLAM system, not ground truth) with traverse-evaluator. With no stage the reference is
+# evaluated against itself. Outputs under out/eval/carmen-NAME-STAGES/; prints one JSON object as
+# its last line.
+#   --stages LIST  comma-separated stage names, e.g. frontend (default: none)
+#   --speed S      replay speed through the graph, times the log's pace (default 10: CARMEN scans
+#                  come about every 3 s, far slower than a frontend needs)
+set -euo pipefail
+# shellcheck source=scripts/eval-common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
+
+usage() {
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
+  exit "${1:-2}"
+}
+
+what="" stages="" speed=10
+while (($#)); do
+  case "$1" in
+    --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
+    --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
+    -h | --help) usage 0 ;;
+    -*) echo "unknown option $1" >&2; usage ;;
+    *) [[ -z $what ]] || usage; what="$1"; shift ;;
+  esac
+done
+[[ -n $what ]] || usage
+
+data="$(cd "$ROOT/.." && pwd)/shared/data/carmen"
+if [[ -f $what ]]; then
+  input="$(cd "$(dirname "$what")" && pwd)/$(basename "$what")"
+  name="$(basename "$what")"
+  name="${name%.gz}"
+  name="${name%.log}"
+  name="${name%-corrected}"
+elif [[ -f $data/$what-corrected.log.gz ]]; then
+  input="$data/$what-corrected.log.gz"
+  name="$what"
+else
+  die "no CARMEN log '$what' (names: $(cd "$data" 2>/dev/null && ls *-corrected.log.gz | sed 's/-corrected\.log\.gz$//' | tr '\n' ' '))"
+fi
+
+need_programs traverse-carmen traverse-evaluator
+
+# 1. The log converted to LCM, cached by name.
+cache="$ROOT/out/cache/carmen-$name.lcmlog"
+mkdir -p "$ROOT/out/cache"
+if stale "$cache" "$BIN/traverse-carmen" "$input"; then
+  echo "eval-carmen: converting $input -> $cache" >&2
+  "$BIN/traverse-carmen" "$input" --out "$cache.tmp" >&2 || die "traverse-carmen failed"
+  mv "$cache.tmp" "$cache"
+fi
+
+# 2. The stages on it, 3. the evaluation of the last stage's trajectory.
+out="$ROOT/out/eval/carmen-$name-$(stages_tag "$stages")"
+rm -rf "$out"
+mkdir -p "$out"
+if [[ -z $stages ]]; then
+  evaluate "$cache" POSE_REFERENCE POSE_REFERENCE "$out"
+else
+  estimate="$(estimate_channel "$stages")"
+  run_graph "$cache" "$out" "$stages" "$speed"
+  evaluate "$out/run.lcmlog" "$estimate" POSE_REFERENCE "$out"
+fi
+echo "eval-carmen: $name stages ${stages:-none}: outputs in $out" >&2
+merged_json "\"carmen\": $(json_str "$name"), \"stages\": $(json_str "$stages"), \"speed\": $speed, \"input\": $(json_str "$input"), \"lcm_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -1,0 +1,105 @@
+# shellcheck shell=bash
+# Shared by scripts/eval-route.sh and scripts/eval-carmen.sh (sourced, not run): finding the
+# programs, the estimate channel of a stage list, running the graph and the evaluator, and merging
+# their JSON into the one object the scripts print last.
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+GRAPH_JSON=""  # run-graph's JSON line, merged into the output under "graph"
+# Programs come from build/bin (scripts/setup.sh builds it when it is missing); TRAVERSE_BIN_DIR
+# points elsewhere, e.g. at another build tree.
+BIN="${TRAVERSE_BIN_DIR:-$ROOT/build/bin}"
+
+die() {
+  echo "$(basename "$0"): $*" >&2
+  exit 1
+}
+
+# Builds nothing itself: runs scripts/setup.sh only when build/bin is missing, then checks that
+# the named programs are there.
+need_programs() {
+  if [[ -z ${TRAVERSE_BIN_DIR:-} && ! -d $BIN ]]; then
+    echo "$(basename "$0"): $BIN is missing, running scripts/setup.sh" >&2
+    "$ROOT/scripts/setup.sh" >&2
+  fi
+  local p
+  for p in "$@"; do
+    [[ -x $BIN/$p ]] || die "$BIN/$p not found (build it: scripts/setup.sh)"
+  done
+}
+
+# The trajectory channel of the last stage in a comma-separated list; later stages add a line.
+estimate_channel() {
+  local last="${1##*,}"
+  case "$last" in
+    frontend) echo POSE_FRONTEND ;;
+    *) die "stage '$last' publishes no trajectory this script knows (add it to estimate_channel)" ;;
+  esac
+}
+
+# "frontend,backend" -> "frontend+backend"; no stage -> "none" (the reference against itself).
+stages_tag() {
+  [[ -z $1 ]] && echo none || echo "${1//,/+}"
+}
+
+# True when $1 is missing or older than any of the other files.
+stale() {
+  local target="$1" f
+  shift
+  [[ -e $target ]] || return 0
+  for f in "$@"; do
+    [[ $f -nt $target ]] && return 0
+  done
+  return 1
+}
+
+# run_graph IN OUTDIR STAGES SPEED: runs the stages on IN; OUTDIR/run.lcmlog records every
+# channel. Its output goes to OUTDIR/graph.out; its JSON line (if any) is kept in GRAPH_JSON.
+run_graph() {
+  local in="$1" out="$2" stages="$3" speed="$4"
+  [[ -x $ROOT/scripts/run-graph.sh ]] || die "scripts/run-graph.sh not found"
+  local rc=0
+  TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$ROOT/configs/deploy/pipeline.yaml" \
+    --log "$in" --out "$out" --speed "$speed" --stages "$stages" >"$out/graph.out" 2>&1 || rc=$?
+  GRAPH_JSON="$(last_json_line "$out/graph.out")"
+  if ((rc != 0)); then
+    tail -n 20 "$out/graph.out" >&2
+    die "run-graph failed (exit $rc), see $out/graph.out"
+  fi
+  [[ -s $out/run.lcmlog ]] || die "run-graph wrote no $out/run.lcmlog"
+}
+
+# The last line of a file if it is a JSON object, else nothing.
+last_json_line() {
+  local line
+  line="$(tail -n 1 "$1" 2>/dev/null || true)"
+  [[ $line == \{*\} ]] && echo "$line" || true
+}
+
+# evaluate LOG ESTIMATE REFERENCE OUTDIR: runs traverse-evaluator; its JSON goes to EVAL_JSON.
+evaluate() {
+  local log="$1" est="$2" ref="$3" out="$4" rc=0
+  "$BIN/traverse-evaluator" --config "$ROOT/configs/evaluator.yaml" --log "$log" \
+    --estimate "$est" --reference "$ref" --out "$out" >"$out/evaluator.out" 2>"$out/evaluator.log" ||
+    rc=$?
+  EVAL_JSON="$(last_json_line "$out/evaluator.out")"
+  if ((rc != 0)) || [[ -z $EVAL_JSON ]]; then
+    cat "$out/evaluator.log" >&2
+    die "traverse-evaluator failed (exit $rc)"
+  fi
+}
+
+# merged_json '"key": value, ...': the evaluator's object with these fields first and the graph's
+# JSON (when run-graph printed one) under "graph".
+merged_json() {
+  local head="$1" body="${EVAL_JSON#\{}"
+  if [[ -n ${GRAPH_JSON:-} ]]; then
+    body="${body%\}}, \"graph\": $GRAPH_JSON}"
+  fi
+  echo "{$head, $body"
+}
+
+# A JSON string literal (quotes and backslashes escaped).
+json_str() {
+  local s="${1//\\/\\\\}"
+  echo "\"${s//\"/\\\"}\""
+}

@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--speed S] [--duration S]
+#
+# One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
+# traverse-sim (cached as out/cache/ROUTE-seedN.lcmlog, regenerated when the sim program, the
+# route or its world is newer), runs the named stages of the graph on it (scripts/run-graph.sh,
+# configs/deploy/pipeline.yaml), and evaluates the last stage's trajectory against the ground
+# truth with traverse-evaluator. With no stage the ground truth is evaluated against itself (a
+# smoke test: every error is zero). Outputs under out/eval/ROUTE-seedN-STAGES/ (run.lcmlog,
+# errors.csv, errors.png, evaluator.log); prints one JSON object as its last line.
+#   --stages LIST  comma-separated stage names, e.g. frontend (default: none)
+#   --seed N       simulator seed (default 1)
+#   --speed S      replay speed through the graph, times real time (default 1)
+#   --duration S   simulate only the route's first S seconds (quick checks; cached and evaluated
+#                  under ROUTE-seedN-dS)
+set -euo pipefail
+# shellcheck source=scripts/eval-common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
+
+usage() {
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
+  exit "${1:-2}"
+}
+
+route="" stages="" seed=1 speed=1 duration=""
+while (($#)); do
+  case "$1" in
+    --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
+    --seed) seed="${2:?--seed needs a number}"; shift 2 ;;
+    --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
+    --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
+    -h | --help) usage 0 ;;
+    -*) echo "unknown option $1" >&2; usage ;;
+    *) [[ -z $route ]] || usage; route="$1"; shift ;;
+  esac
+done
+[[ -n $route ]] || usage
+[[ $route =~ ^[A-Za-z0-9._-]+$ && $route != .* ]] || die "route must be a name from configs/routes/, not '$route'"
+[[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, not '$seed'"
+[[ -z $duration || $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--duration must be seconds, not '$duration'"
+
+route_file="$ROOT/configs/routes/$route.yaml"
+[[ -f $route_file ]] || die "no route $route_file (routes: $(cd "$ROOT/configs/routes" && ls *.yaml | sed 's/\.yaml$//' | tr '\n' ' '))"
+# The route names its world: "world: office" (configs/worlds/office.yaml) or a path.
+world="$(sed -n 's/^world:[[:space:]]*\([^#[:space:]]*\).*/\1/p' "$route_file" | head -n 1)"
+[[ -n $world ]] || die "$route_file has no 'world:' key"
+case "$world" in
+  */* | *.yaml) world_file="$ROOT/$world" ;;
+  *) world_file="$ROOT/configs/worlds/$world.yaml" ;;
+esac
+[[ -f $world_file ]] || die "world $world_file (named by $route_file) not found"
+
+need_programs traverse-sim traverse-evaluator
+
+# 1. The simulated log, cached by route and seed.
+run_name="$route-seed$seed${duration:+-d$duration}"
+cache="$ROOT/out/cache/$run_name.lcmlog"
+mkdir -p "$ROOT/out/cache"
+if stale "$cache" "$BIN/traverse-sim" "$route_file" "$world_file"; then
+  echo "eval-route: simulating $route (seed $seed) -> $cache" >&2
+  sim_start_ns=$(date +%s%N)
+  "$BIN/traverse-sim" --world "$world_file" --route "$route_file" --seed "$seed" \
+    ${duration:+--duration "$duration"} --out "$cache.tmp" >&2 || die "traverse-sim failed"
+  mv "$cache.tmp" "$cache"
+  echo "eval-route: simulated in $((($(date +%s%N) - sim_start_ns) / 1000000)) ms" >&2
+fi
+
+# 2. The stages on it, 3. the evaluation of the last stage's trajectory.
+out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")"
+rm -rf "$out"
+mkdir -p "$out"
+if [[ -z $stages ]]; then
+  evaluate "$cache" POSE_GROUND_TRUTH POSE_GROUND_TRUTH "$out"
+else
+  estimate="$(estimate_channel "$stages")"
+  run_graph "$cache" "$out" "$stages" "$speed"
+  evaluate "$out/run.lcmlog" "$estimate" POSE_GROUND_TRUTH "$out"
+fi
+echo "eval-route: $route seed $seed stages ${stages:-none}: outputs in $out" >&2
+merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Runs the process graph of a deployment file on a private LCM URL, replaying an LCM log:
+#
+#   scripts/run-graph.sh --deploy configs/deploy/pipeline.yaml --log INPUT.lcmlog --out OUTDIR \
+#       [--speed S] [--stages NAME,NAME|all] [--lcm-url URL] [--grace S] [--stop-timeout S]
+#
+# --speed multiplies the log's own pace (default 1; 0 replays as fast as possible, with losses).
+#
+# Records every channel into OUTDIR/run.lcmlog, the monitor's summary into OUTDIR/monitor.json and
+# each process's output into OUTDIR/<name>.log, and its own summary (JSON line last on stdout) into
+# OUTDIR/run-graph.json. Exits non-zero if a process died (it says which); 130 after Ctrl-C.
+# Programs come from build/bin (or $TRAVERSE_BIN_DIR); relative config paths in the deployment
+# file are taken from the repository root.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BIN="${TRAVERSE_BIN_DIR:-$ROOT/build/bin}"
+if [[ ${1:-} == -h || ${1:-} == --help ]]; then
+  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | grep '^#' | sed 's/^# \{0,1\}//'
+  [[ -x $BIN/traverse-launch ]] && exec "$BIN/traverse-launch" --help
+  exit 0
+fi
+if [[ ! -x $BIN/traverse-launch ]]; then
+  echo "run-graph.sh: $BIN/traverse-launch is not built (run scripts/setup.sh)" >&2
+  exit 2
+fi
+exec "$BIN/traverse-launch" --root "$ROOT" --bin-dir "$BIN" "$@"

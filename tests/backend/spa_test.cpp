@@ -1,0 +1,109 @@
+#include "spa.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "test_graphs.hpp"
+
+namespace traverse::backend {
+namespace {
+
+// A square of four poses, two laps, measured without noise: the optimum has chi2 = 0.
+PoseGraph exact_square() {
+  std::vector<Pose2> truth;
+  for (int k = 0; k < 8; ++k) truth.emplace_back(Pose2(0, 0, k * M_PI / 2) * Pose2(2.0, 0.0, 0.0));
+  PoseGraph g;
+  Eigen::Matrix3d info = Eigen::Vector3d(100.0, 25.0, 400.0).asDiagonal();
+  for (int k = 0; k < 8; ++k) g.add_vertex(k, truth[k]);
+  for (int k = 1; k < 8; ++k) g.edges.push_back({k - 1, k, between(truth[k - 1], truth[k]), info});
+  for (int k = 0; k < 4; ++k) g.edges.push_back({k, k + 4, between(truth[k], truth[k + 4]), info});
+  return g;
+}
+
+TEST(Spa, RecoversExactGraphFromPerturbedStart) {
+  PoseGraph g = exact_square();
+  const std::vector<Pose2> truth = g.poses;
+  for (std::size_t k = 1; k < g.poses.size(); ++k) {
+    g.poses[k] = g.poses[k] * Pose2(0.3, -0.2, 0.25);
+  }
+  SpaOptimizer optimizer;
+  const SpaResult r = optimizer.optimize(g);
+  EXPECT_TRUE(r.converged) << r.termination;
+  EXPECT_GT(r.initial_chi2, 1.0);
+  EXPECT_LT(r.final_chi2, 1e-12);
+  EXPECT_TRUE(g.fixed[0]);
+  for (std::size_t k = 0; k < g.poses.size(); ++k) {
+    EXPECT_NEAR(g.poses[k].x(), truth[k].x(), 1e-7);
+    EXPECT_NEAR(g.poses[k].y(), truth[k].y(), 1e-7);
+    EXPECT_NEAR(wrap_angle(g.poses[k].theta() - truth[k].theta()), 0.0, 1e-7);
+  }
+}
+
+TEST(Spa, ConvergesOnNoisyGraphToAStationaryPoint) {
+  PoseGraph g = testing::make_walk_graph(150, 3);
+  ASSERT_GT(g.edges.size(), 160u);  // loop closures exist
+  SpaOptimizer optimizer;
+  const SpaResult r = optimizer.optimize(g);
+  EXPECT_TRUE(r.converged) << r.termination;
+  EXPECT_LT(r.final_chi2, r.initial_chi2);
+  // A second run from the optimum cannot lower chi2 by more than the tolerance.
+  const SpaResult again = optimizer.optimize(g);
+  EXPECT_TRUE(again.converged);
+  EXPECT_NEAR(again.final_chi2, r.final_chi2, 1e-8 * r.final_chi2);
+  // chi2 of a well-modelled graph is about (3 edges - 3 (vertices - 1)) in expectation.
+  const double dof = 3.0 * (g.edges.size() - (g.poses.size() - 1));
+  EXPECT_LT(r.final_chi2, 3.0 * dof);
+}
+
+TEST(Spa, ReusesSymbolicAnalysisWhileThePatternIsUnchanged) {
+  PoseGraph g = testing::make_walk_graph(60, 5);
+  SpaOptimizer optimizer;
+  optimizer.optimize(g);
+  EXPECT_EQ(optimizer.system().analyses(), 1);
+  g.poses[10] = g.poses[10] * Pose2(0.2, 0.1, 0.1);  // new values, same pattern
+  const SpaResult r = optimizer.optimize(g);
+  EXPECT_GT(r.iterations, 1);
+  EXPECT_EQ(optimizer.system().analyses(), 1);
+  // A repeated measurement between already linked vertices keeps the block pattern.
+  g.edges.push_back(g.edges[3]);
+  optimizer.optimize(g);
+  EXPECT_EQ(optimizer.system().analyses(), 1);
+  // A new loop closure changes it.
+  g.edges.push_back({2, 50, between(g.poses[2], g.poses[50]), Eigen::Matrix3d::Identity()});
+  optimizer.optimize(g);
+  EXPECT_EQ(optimizer.system().analyses(), 2);
+}
+
+TEST(Spa, NonFiniteCostKeepsThePreviousState) {
+  // A degenerate measurement (NaN information, as a failed matcher might produce) added to an
+  // optimised graph: the optimiser reports it and leaves the poses untouched.
+  PoseGraph g = testing::make_walk_graph(40, 9);
+  SpaOptimizer optimizer;
+  ASSERT_TRUE(optimizer.optimize(g).converged);
+  const std::vector<Pose2> good = g.poses;
+  Eigen::Matrix3d bad = Eigen::Matrix3d::Identity();
+  bad(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  g.edges.push_back({0, 30, Pose2(1.0, 0.0, 0.0), bad});
+  const SpaResult r = optimizer.optimize(g);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.termination, "initial chi2 is not finite");
+  for (std::size_t k = 0; k < g.poses.size(); ++k) {
+    EXPECT_EQ(g.poses[k].x(), good[k].x());
+    EXPECT_EQ(g.poses[k].theta(), good[k].theta());
+  }
+}
+
+TEST(Spa, HitsTheIterationCapWithoutClaimingConvergence) {
+  PoseGraph g = testing::make_walk_graph(80, 4, 0.2);
+  SpaConfig config;
+  config.max_iterations = 1;
+  SpaOptimizer optimizer(config);
+  const SpaResult r = optimizer.optimize(g);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.termination, "iteration cap reached");
+}
+
+}  // namespace
+}  // namespace traverse::backend

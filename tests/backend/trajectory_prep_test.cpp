@@ -1,0 +1,103 @@
+#include "trajectory_prep.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace traverse::backend {
+namespace {
+
+constexpr int64_t kScanPeriodUs = 25000;  // 40 Hz
+
+// Constant body-frame velocity (vx [m/s], omega [rad/s]) for n scans.
+std::vector<StampedPose> drive(int n, double vx, double omega) {
+  std::vector<StampedPose> poses{{0, Pose2()}};
+  const double dt = 1e-6 * kScanPeriodUs;
+  for (int k = 1; k < n; ++k) {
+    poses.push_back(
+        {k * kScanPeriodUs, poses.back().T_world_base * Pose2(vx * dt, 0.0, omega * dt)});
+  }
+  return poses;
+}
+
+TEST(JumpSmoothing, KeepsSmoothMotionUnchanged) {
+  for (const auto& poses : {drive(200, 1.2, 0.0), drive(200, 0.8, 0.7), drive(200, 0.0, 0.0)}) {
+    const SmoothedTrajectory s = smooth_jumps(poses, {});
+    EXPECT_TRUE(s.replaced_steps.empty());
+    ASSERT_EQ(s.poses.size(), poses.size());
+    EXPECT_NEAR(
+        (s.poses.back().T_world_base.translation() - poses.back().T_world_base.translation())
+            .norm(),
+        0.0, 1e-9);
+  }
+}
+
+TEST(JumpSmoothing, IgnoresJitterAtRest) {
+  std::mt19937 rng(1);
+  std::normal_distribution<double> mm(0.0, 0.001), mrad(0.0, 0.001);
+  std::vector<StampedPose> poses;
+  for (int k = 0; k < 200; ++k)
+    poses.push_back({k * kScanPeriodUs, Pose2(mm(rng), mm(rng), mrad(rng))});
+  EXPECT_TRUE(smooth_jumps(poses, {}).replaced_steps.empty());
+}
+
+TEST(JumpSmoothing, ReplacesALoopClosureJumpAndCarriesTheRestAlong) {
+  // Walking straight at 1 m/s; at scan 80 the frontend snaps 0.4 m sideways and 0.3 m back.
+  std::vector<StampedPose> poses = drive(160, 1.0, 0.0);
+  for (std::size_t k = 80; k < poses.size(); ++k) {
+    poses[k].T_world_base = Pose2(-0.3, 0.4, 0.0) * poses[k].T_world_base;
+  }
+  const SmoothedTrajectory s = smooth_jumps(poses, {});
+  ASSERT_EQ(s.replaced_steps, std::vector<int>{80});
+  // The replaced step is the average step (0.025 m forward), so the smoothed trajectory is the
+  // jump-free one.
+  const std::vector<StampedPose> clean = drive(160, 1.0, 0.0);
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(
+        (s.poses[k].T_world_base.translation() - clean[k].T_world_base.translation()).norm(), 0.0,
+        1e-9)
+        << k;
+    EXPECT_EQ(s.poses[k].utime, poses[k].utime);
+  }
+}
+
+TEST(JumpSmoothing, ReplacesAHeadingJump) {
+  std::vector<StampedPose> poses = drive(100, 0.5, 0.1);
+  for (std::size_t k = 60; k < poses.size(); ++k) {
+    poses[k].T_world_base = poses[k].T_world_base * Pose2(0.0, 0.0, 0.3);  // 12 rad/s in one scan
+  }
+  EXPECT_EQ(smooth_jumps(poses, {}).replaced_steps, std::vector<int>{60});
+}
+
+TEST(KeyPoses, ThreePerSecondByTime) {
+  const std::vector<StampedPose> poses = drive(121, 1.0, 0.0);  // 3 s at 40 Hz
+  const std::vector<int> keys = select_key_poses(poses, {});
+  // 333333 us at 25000 us per scan: every 14th scan.
+  ASSERT_EQ(keys.size(), 9u);
+  for (std::size_t i = 0; i < keys.size(); ++i) EXPECT_EQ(keys[i], static_cast<int>(14 * i));
+}
+
+TEST(KeyPoses, ByDistanceAndAngle) {
+  KeyPoseConfig by_distance;
+  by_distance.interval_us = 0;
+  by_distance.distance_m = 0.5;
+  const std::vector<StampedPose> straight = drive(200, 1.0, 0.0);
+  const std::vector<int> keys = select_key_poses(straight, by_distance);
+  ASSERT_GT(keys.size(), 5u);
+  for (std::size_t i = 1; i < keys.size(); ++i) {
+    const double d = (straight[keys[i]].T_world_base.translation() -
+                      straight[keys[i - 1]].T_world_base.translation())
+                         .norm();
+    EXPECT_GE(d, 0.5 - 1e-9);
+    EXPECT_LT(d, 0.5 + 0.025 + 1e-9);
+  }
+  KeyPoseConfig by_angle;
+  by_angle.interval_us = 0;
+  by_angle.angle_rad = 0.5;
+  const std::vector<int> turning = select_key_poses(drive(200, 0.0, 1.0), by_angle);
+  EXPECT_EQ(turning.size(), 1u + 199 / 20);  // 0.025 rad per scan: every 20 scans
+  EXPECT_EQ(select_key_poses(drive(200, 0.0, 1.0), by_distance).size(), 1u);  // no travel
+}
+
+}  // namespace
+}  // namespace traverse::backend

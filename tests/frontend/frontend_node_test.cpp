@@ -1,0 +1,113 @@
+#include "frontend_node.hpp"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "synthetic_scans.hpp"
+#include "traverse/pose2d_t.hpp"
+
+namespace traverse::frontend {
+namespace {
+
+planar_scan_t to_message(const Scan& scan) {
+  planar_scan_t msg{};
+  msg.utime = scan.utime_first;
+  msg.frame = "laser_horizontal";
+  msg.utime_first = scan.utime_first;
+  msg.utime_last = scan.utime_last;
+  msg.angle_first = static_cast<float>(scan.angle_first);
+  msg.angle_step = static_cast<float>(scan.angle_step);
+  msg.range_min = static_cast<float>(scan.range_min);
+  msg.range_max = static_cast<float>(scan.range_max);
+  msg.ranges = scan.ranges;
+  msg.n_ranges = static_cast<int32_t>(scan.ranges.size());
+  return msg;
+}
+
+imu_t imu_at(int64_t utime) {
+  imu_t m{};
+  m.utime = utime;
+  m.frame = "imu";
+  return m;
+}
+
+class FrontendNodeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    config_.scan_channel = "TEST_SCAN";
+    config_.pose_channel = "TEST_POSE";
+    node_ = std::make_unique<FrontendNode>(
+        bus_, config_, [this](const std::string& k, double v) { counters_[k] = v; });
+    bus_.subscribe<pose2d_t>("TEST_POSE", [this](const pose2d_t& p) { poses_.push_back(p); });
+  }
+  void handle_all() {
+    while (bus_.lcm().handleTimeout(0) > 0) {
+    }
+  }
+  planar_scan_t scan(int k) {
+    synthetic::SweepSpec spec;
+    spec.n_ranges = 900;
+    spec.angle_step = 300.0 * M_PI / 180.0 / 899.0;
+    spec.utime_first = 1'000'000 + k * 20964;
+    return to_message(synthetic::make_sweep(
+        synthetic::room(), [](int64_t) { return Pose2(); }, Pose2(), spec));
+  }
+
+  Bus bus_{"memq://"};
+  FrontendConfig config_;
+  std::unique_ptr<FrontendNode> node_;
+  std::vector<pose2d_t> poses_;
+  std::map<std::string, double> counters_;
+};
+
+TEST_F(FrontendNodeTest, PublishesOnePosePerScanWithoutImu) {
+  for (int k = 0; k < 3; ++k) {
+    auto m = scan(k);
+    bus_.publish("TEST_SCAN", m);
+  }
+  handle_all();
+  ASSERT_EQ(poses_.size(), 3u);
+  for (const auto& p : poses_) {
+    EXPECT_EQ(p.parent_frame, "map");
+    EXPECT_EQ(p.child_frame, "base");
+    EXPECT_EQ(p.flags, 0);
+    EXPECT_NEAR(p.x, 0.0, 0.005);
+    EXPECT_DOUBLE_EQ(p.covariance[1], p.covariance[3]);  // symmetric
+    EXPECT_GT(p.covariance[0], 0.0);
+  }
+  EXPECT_EQ(poses_[2].utime, scan(2).utime_last);
+  node_->report_counters();
+  EXPECT_EQ(counters_.at("scans_matched"), 3);
+  EXPECT_GT(counters_.at("map_bytes"), 0);
+}
+
+TEST_F(FrontendNodeTest, ScanWaitsForImuCoveringItsLastPoint) {
+  auto i0 = imu_at(900'000);
+  bus_.publish(config_.imu_channel, i0);
+  auto s0 = scan(0);
+  bus_.publish("TEST_SCAN", s0);
+  handle_all();
+  EXPECT_TRUE(poses_.empty());  // IMU has not reached the sweep's end yet
+  auto i1 = imu_at(s0.utime_last + 1000);
+  bus_.publish(config_.imu_channel, i1);
+  handle_all();
+  EXPECT_EQ(poses_.size(), 1u);
+}
+
+TEST_F(FrontendNodeTest, TooFewPointsIsPublishedFlaggedAndCounted) {
+  auto s0 = scan(0);
+  bus_.publish("TEST_SCAN", s0);
+  auto s1 = scan(1);
+  for (auto& r : s1.ranges) r = 0.0f;
+  bus_.publish("TEST_SCAN", s1);
+  handle_all();
+  ASSERT_EQ(poses_.size(), 2u);
+  EXPECT_EQ(poses_[1].flags & pose2d_t::FLAG_PREDICTED, pose2d_t::FLAG_PREDICTED);
+  node_->report_counters();
+  EXPECT_EQ(counters_.at("scans_predicted"), 1);
+  EXPECT_EQ(counters_.at("readings_invalid"), 900);
+}
+
+}  // namespace
+}  // namespace traverse::frontend

@@ -1,0 +1,164 @@
+#include "frontend.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "synthetic_scans.hpp"
+
+namespace traverse::frontend {
+namespace {
+
+constexpr int64_t kPeriodUs = 20964;  // 47.7 Hz
+
+// A small, fast setup: 1,800-point sweeps of 300 degrees in the synthetic room.
+synthetic::SweepSpec small_sweep(int64_t utime_first) {
+  synthetic::SweepSpec spec;
+  spec.n_ranges = 1800;
+  spec.angle_step = 300.0 * M_PI / 180.0 / 1799.0;
+  spec.utime_first = utime_first;
+  spec.noise_sigma_m = 0.002;
+  return spec;
+}
+
+// Walks, weaves and turns through the room; returns the final pose error [m] and [rad].
+struct RoomRun {
+  double position_error_m = 0.0, heading_error_rad = 0.0;
+  FrontendCounters counters;
+};
+RoomRun run_room(const FrontendConfig& config, bool with_imu, double turn_rate, int scans = 120) {
+  const auto world = synthetic::room();
+  // Starting from rest: speed and turn rate ramp up over 0.5 s (ramp is the integral of the
+  // profile min(1, 2 s)), as a pushed cart does.
+  auto ramp = [](double s) { return s < 0.5 ? s * s : s - 0.25; };
+  auto truth = [&](int64_t t) {
+    const double s = ramp(1e-6 * static_cast<double>(t));
+    return Pose2(-2.0 + 0.5 * s, -1.0 + 0.3 * std::sin(s), turn_rate * s);
+  };
+  auto yaw_rate = [&](int64_t t) { return turn_rate * std::min(1.0, 2e-6 * static_cast<double>(t)); };
+  Frontend frontend(config);
+  std::mt19937 rng(3);
+  RoomRun run;
+  int64_t imu_t = 0;
+  const Pose2 T_laser;
+  Pose2 T_map_world;
+  for (int k = 0; k < scans; ++k) {
+    const Scan scan = synthetic::make_sweep(world, truth, T_laser, small_sweep(k * kPeriodUs), &rng);
+    for (; with_imu && imu_t <= scan.utime_last; imu_t += 5000) {
+      frontend.add_imu(imu_t, Eigen::Vector3d(0.01, -0.02, yaw_rate(imu_t)));
+    }
+    const FrontendResult r = frontend.process(scan);
+    EXPECT_EQ(r.status, ScanStatus::kMatched);
+    if (k == 0) T_map_world = truth(scan.utime_last).inverse();
+    const Pose2 T_map_base_true = T_map_world * truth(scan.utime_last);
+    run.position_error_m = (r.T_map_base.translation() - T_map_base_true.translation()).norm();
+    run.heading_error_rad = std::abs(wrap_angle(r.T_map_base.theta() - T_map_base_true.theta()));
+  }
+  run.counters = frontend.counters();
+  return run;
+}
+
+TEST(Frontend, TracksWalkThroughRoomWithImu) {
+  const RoomRun run = run_room(FrontendConfig{}, true, 0.4);
+  EXPECT_LT(run.position_error_m, 0.005);
+  EXPECT_LT(run.heading_error_rad, 0.001);
+  EXPECT_GT(run.counters.map_updates, 2);
+  EXPECT_GT(run.counters.imu_samples, 500);
+}
+
+// Without IMU the sweep's rotation comes from the constant-velocity estimate.
+TEST(Frontend, TracksWithoutImu) {
+  const RoomRun run = run_room(FrontendConfig{}, false, 0.4);
+  EXPECT_LT(run.position_error_m, 0.005);
+  EXPECT_LT(run.heading_error_rad, 0.001);
+  EXPECT_EQ(run.counters.imu_samples, 0);
+}
+
+// Turning fast (1.5 rad/s, a turn on the spot's pace): de-skew removes the error that the sweep's
+// own rotation puts into every scan and, through map updates, into the map.
+TEST(Frontend, DeskewReducesErrorWhileTurningFast) {
+  FrontendConfig on, off;
+  off.deskew.enabled = false;
+  const RoomRun with = run_room(on, true, 1.5);
+  const RoomRun without = run_room(off, true, 1.5);
+  EXPECT_LT(with.heading_error_rad, 0.002);
+  EXPECT_LT(with.position_error_m, 0.005);
+  EXPECT_GT(without.heading_error_rad, 0.01);
+}
+
+class FrontendBadScans : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // Standing still for a few scans builds the map and the (zero) velocity.
+    for (int k = 0; k < 5; ++k) {
+      ASSERT_EQ(frontend_.process(good_scan(k)).status, ScanStatus::kMatched);
+    }
+  }
+  Scan good_scan(int k) {
+    return synthetic::make_sweep(world_, [](int64_t) { return Pose2(0.2, 0.1, 0.0); }, Pose2(),
+                                 small_sweep(k * kPeriodUs), &rng_);
+  }
+  synthetic::World world_ = synthetic::room();
+  std::mt19937 rng_{5};
+  Frontend frontend_{FrontendConfig{}};
+};
+
+TEST_F(FrontendBadScans, IgnoresNanZeroNegativeAndOutOfRangeReadings) {
+  Scan scan = good_scan(5);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> bad = {nan, 0.0f, -1.0f, inf, 0.01f, 60.0f};
+  int replaced = 0;
+  for (std::size_t i = 0; i < scan.ranges.size(); i += 3) {
+    scan.ranges[i] = bad[(i / 3) % bad.size()];
+    ++replaced;
+  }
+  const int64_t invalid_before = frontend_.counters().readings_invalid;
+  const FrontendResult r = frontend_.process(scan);
+  EXPECT_EQ(r.status, ScanStatus::kMatched);
+  EXPECT_EQ(r.valid_points, static_cast<int>(scan.ranges.size()) - replaced);
+  EXPECT_EQ(frontend_.counters().readings_invalid - invalid_before, replaced);
+  EXPECT_LT(r.T_map_base.translation().norm(), 0.005);  // still where it stood
+}
+
+TEST_F(FrontendBadScans, TooFewValidPointsGivesFlaggedPrediction) {
+  Scan blind = good_scan(5);
+  for (std::size_t i = 0; i < blind.ranges.size(); ++i) {
+    if (i % 200 != 0) blind.ranges[i] = std::numeric_limits<float>::quiet_NaN();
+  }
+  const FrontendResult r = frontend_.process(blind);
+  EXPECT_EQ(r.status, ScanStatus::kPredicted);
+  EXPECT_EQ(r.valid_points, 9);
+  EXPECT_LT(r.T_map_base.translation().norm(), 0.005);  // constant (zero) velocity
+  EXPECT_GT(r.covariance(0, 0), 0.1);                   // and honest about it
+  EXPECT_EQ(frontend_.counters().scans_predicted, 1);
+  // An empty scan is too few points as well; the next good scan is matched again.
+  Scan empty = good_scan(6);
+  empty.ranges.clear();
+  EXPECT_EQ(frontend_.process(empty).status, ScanStatus::kPredicted);
+  EXPECT_EQ(frontend_.process(good_scan(7)).status, ScanStatus::kMatched);
+  EXPECT_EQ(frontend_.counters().scans_predicted, 2);
+}
+
+TEST_F(FrontendBadScans, DropsScansWhoseTimeGoesBackOrIsInconsistent) {
+  Scan reversed = good_scan(5);
+  std::swap(reversed.utime_first, reversed.utime_last);  // last point before the first
+  EXPECT_EQ(frontend_.process(reversed).status, ScanStatus::kDropped);
+  EXPECT_EQ(frontend_.process(good_scan(2)).status, ScanStatus::kDropped);  // back in time
+  EXPECT_EQ(frontend_.process(good_scan(4)).status, ScanStatus::kDropped);  // same time again
+  EXPECT_EQ(frontend_.counters().scans_dropped_time, 3);
+  EXPECT_EQ(frontend_.process(good_scan(5)).status, ScanStatus::kMatched);
+}
+
+TEST(Frontend, DropsImuSamplesGoingBack) {
+  Frontend frontend{FrontendConfig{}};
+  frontend.add_imu(100, Eigen::Vector3d::Zero());
+  frontend.add_imu(50, Eigen::Vector3d::Zero());
+  frontend.add_imu(200, Eigen::Vector3d(0, 0, std::nan("")));
+  EXPECT_EQ(frontend.counters().imu_samples, 1);
+  EXPECT_EQ(frontend.counters().imu_dropped_time, 2);
+}
+
+}  // namespace
+}  // namespace traverse::frontend

@@ -1,0 +1,104 @@
+#include "occupancy_grid.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "synthetic_scans.hpp"
+
+namespace traverse::frontend {
+namespace {
+
+// A grid that has seen the synthetic room from a few places.
+OccupancyGrid room_grid(double resolution) {
+  OccupancyGrid grid(resolution, 0.9, 0.4);
+  const auto world = synthetic::room();
+  for (const Eigen::Vector2d& origin : {Eigen::Vector2d(0, 0), Eigen::Vector2d(-2, 1)}) {
+    std::vector<Eigen::Vector2d> hits;
+    for (int i = 0; i < 2000; ++i) {
+      const double a = 2.0 * M_PI * i / 2000.0;
+      const Eigen::Vector2d d(std::cos(a), std::sin(a));
+      if (auto r = synthetic::cast_ray(world, origin, d, 30.0)) hits.push_back(origin + *r * d);
+    }
+    grid.update(origin, hits);
+  }
+  return grid;
+}
+
+TEST(OccupancyGrid, UnobservedIsHalfAndHitsAreOccupiedRaysFree) {
+  OccupancyGrid grid(0.05, 0.9, 0.4);
+  EXPECT_DOUBLE_EQ(grid.value({1.0, 2.0}), 0.5);
+  grid.update({0.0, 0.0}, {{1.0, 0.0}});
+  EXPECT_NEAR(grid.cell_probability(20, 0), 0.9, 0.01);
+  EXPECT_NEAR(grid.cell_probability(10, 0), 0.4, 0.01);
+  EXPECT_DOUBLE_EQ(grid.cell_probability(21, 0), 0.5);  // behind the wall: not seen
+}
+
+TEST(OccupancyGrid, HitWinsOverTraversalWithinOneScan) {
+  OccupancyGrid grid(0.05, 0.9, 0.4);
+  // The second beam passes through the first beam's end point cell on its way further out.
+  grid.update({0.0, 0.0}, {{1.0, 0.0}, {2.0, 0.0}});
+  EXPECT_GT(grid.cell_probability(20, 0), 0.85);
+  EXPECT_GT(grid.cell_probability(40, 0), 0.85);
+}
+
+TEST(OccupancyGrid, InterpolatesCellValuesAtSamplePoints) {
+  const OccupancyGrid grid = room_grid(0.1);
+  for (int ix = -40; ix <= 40; ix += 7) {
+    for (int iy = -40; iy <= 40; iy += 9) {
+      EXPECT_NEAR(grid.value({ix * 0.1, iy * 0.1}), grid.cell_probability(ix, iy), 1e-9);
+    }
+  }
+}
+
+TEST(OccupancyGrid, BilinearGradientMatchesNumericalDerivative) {
+  const double res = 0.05;
+  const OccupancyGrid grid = room_grid(res);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coord(-5.5, 5.5), frac(0.1, 0.9);
+  int informative = 0;
+  for (int k = 0; k < 2000; ++k) {
+    // Stay inside one cell so the interpolant is smooth around the point.
+    const Eigen::Vector2d p(std::floor(coord(rng) / res + 0.5) * res + frac(rng) * res,
+                            std::floor(coord(rng) / res + 0.5) * res + frac(rng) * res);
+    Eigen::Vector2d grad;
+    grid.value(p, &grad);
+    const double h = 1e-6;
+    const double gx = (grid.value(p + Eigen::Vector2d(h, 0)) - grid.value(p - Eigen::Vector2d(h, 0))) / (2 * h);
+    const double gy = (grid.value(p + Eigen::Vector2d(0, h)) - grid.value(p - Eigen::Vector2d(0, h))) / (2 * h);
+    EXPECT_NEAR(grad.x(), gx, 1e-4 * (1.0 + std::abs(gx)));
+    EXPECT_NEAR(grad.y(), gy, 1e-4 * (1.0 + std::abs(gy)));
+    if (grad.norm() > 1.0) ++informative;
+  }
+  EXPECT_GT(informative, 50);  // the check saw walls, not only flat free space
+}
+
+TEST(OccupancyGrid, GrowsBeyondAnyInitialExtentInAllDirections) {
+  OccupancyGrid grid(0.05, 0.9, 0.4);
+  grid.update({0, 0}, {{1, 0}});
+  const std::size_t small = grid.memory_bytes();
+  // A 300 m route and more, in negative and positive directions: no edge to hit.
+  const std::vector<Eigen::Vector2d> far = {{310.0, 5.0}, {-250.0, -420.0}, {3.0, 1000.0}};
+  for (const auto& p : far) grid.update(p - Eigen::Vector2d(0.5, 0), {p});
+  for (const auto& p : far) EXPECT_GT(grid.value(p), 0.85) << p.transpose();
+  EXPECT_GT(grid.memory_bytes(), small);
+  EXPECT_LE(grid.min_corner().x(), -250.0);
+  EXPECT_LE(grid.min_corner().y(), -420.0);
+  EXPECT_GE(grid.max_corner().x(), 310.0);
+  EXPECT_GE(grid.max_corner().y(), 1000.0);
+  // Memory follows the area seen, not the bounding box (which would be 560 m x 1420 m).
+  EXPECT_LT(grid.memory_bytes(), 20 * sizeof(int16_t) * OccupancyGrid::kTileCells);
+}
+
+TEST(OccupancyGrid, EvictsFarthestTilesToStayUnderBudget) {
+  OccupancyGrid grid(0.05, 0.9, 0.4);
+  for (int i = 0; i < 50; ++i) grid.update({i * 10.0, 0}, {{i * 10.0 + 1.0, 0}});
+  const std::size_t budget = grid.memory_bytes() / 2;
+  EXPECT_GT(grid.evict_farthest({0, 0}, budget), 0u);
+  EXPECT_LE(grid.memory_bytes(), budget);
+  EXPECT_GT(grid.value({1.0, 0}), 0.85);      // near the pose: kept
+  EXPECT_DOUBLE_EQ(grid.value({491.0, 0}), 0.5);  // far away: forgotten
+}
+
+}  // namespace
+}  // namespace traverse::frontend

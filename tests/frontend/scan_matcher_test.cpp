@@ -1,0 +1,131 @@
+#include "scan_matcher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "test_scans.hpp"
+
+namespace traverse::frontend {
+namespace {
+
+using testing::build_map;
+using testing::static_scan;
+
+const Pose2 kMapPose(0.3, -0.2, 0.1);
+
+class MatcherLevel : public ::testing::TestWithParam<int> {};
+
+// Matching on one level alone, from an offset of about one cell of that level, recovers the pose
+// to a small fraction of the cell.
+TEST_P(MatcherLevel, RecoversKnownOffsetOnLevel) {
+  const int level = GetParam();
+  const auto world = synthetic::room();
+  MapConfig map_config;
+  const MapPyramid maps = build_map(world, {kMapPose, Pose2(-1.5, 1.0, 0.0)}, map_config);
+  const double res = maps.level(level).resolution();
+  const Pose2 truth(0.5, 0.4, 0.3);
+  const auto points = static_scan(world, truth);
+  const Pose2 start(truth.x() + 0.8 * res, truth.y() - 0.6 * res, truth.theta() + 0.03);
+  MatcherConfig config;
+  config.iterations_coarse = config.iterations_fine = 20;
+  const MatchResult r = match_scan(maps, points, start, config, level, level);
+  EXPECT_LT((r.T_map_base.translation() - truth.translation()).norm(), 0.1 * res) << "level " << level;
+  EXPECT_LT(std::abs(wrap_angle(r.T_map_base.theta() - truth.theta())), 0.003);
+}
+
+INSTANTIATE_TEST_SUITE_P(Levels, MatcherLevel, ::testing::Values(0, 1, 2));
+
+// The whole pyramid, coarse to fine, converges from further away than any single fine level.
+TEST(ScanMatcher, PyramidConvergesFromLargeOffset) {
+  const auto world = synthetic::room();
+  const MapPyramid maps = build_map(world, {kMapPose});
+  const Pose2 truth(0.2, -0.5, 0.2);
+  const auto points = static_scan(world, truth, 1440, 0.005);
+  const Pose2 start(truth.x() - 0.25, truth.y() + 0.2, truth.theta() - 0.12);
+  const MatchResult r = match_scan(maps, points, start, MatcherConfig{});
+  EXPECT_LT((r.T_map_base.translation() - truth.translation()).norm(), 0.01);
+  EXPECT_LT(std::abs(wrap_angle(r.T_map_base.theta() - truth.theta())), 0.002);
+  // A single fine level from the same start stays in a wrong local minimum or converges slowly.
+  MatcherConfig fine_only;
+  const MatchResult f = match_scan(maps, points, start, fine_only, 0, 0);
+  EXPECT_GT((f.T_map_base.translation() - truth.translation()).norm(), 0.01);
+}
+
+// The hand-written Jacobian: the gradient of the cost sum r^2 is -2 sum J^T r.
+TEST(ScanMatcher, NormalEquationsGradientMatchesNumericalCost) {
+  const auto world = synthetic::room();
+  const MapPyramid maps = build_map(world, {kMapPose});
+  const auto points = static_scan(world, Pose2(0.1, 0.1, 0.05), 720);
+  const Pose2 at(0.117, 0.089, 0.061);
+  const NormalEquations ne = normal_equations(maps.level(0), points, at);
+  const double h[3] = {1e-6, 1e-6, 1e-7};
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    d[k] = h[k];
+    const Eigen::Vector3d p = at.vector() + d, m = at.vector() - d;
+    const double cp = normal_equations(maps.level(0), points, Pose2(p.x(), p.y(), p.z())).cost;
+    const double cm = normal_equations(maps.level(0), points, Pose2(m.x(), m.y(), m.z())).cost;
+    const double numerical = (cp - cm) / (2 * h[k]);
+    EXPECT_NEAR(-2.0 * ne.g[k], numerical, 1e-3 * (1.0 + std::abs(numerical))) << "k " << k;
+  }
+}
+
+// Covariance: small where walls in all directions fix the pose; large along a corridor's axis.
+TEST(ScanMatcher, CovarianceShrinksWithGeometryAndGrowsAlongCorridorAxis) {
+  const MatcherConfig config;
+  const auto room = synthetic::room();
+  const MapPyramid room_map = build_map(room, {Pose2()});
+  const Pose2 truth(0.1, 0.05, 0.0);
+  const MatchResult in_room = match_scan(room_map, static_scan(room, truth, 1440, 0.005), truth, config);
+
+  const auto corridor = synthetic::corridor(200.0, 2.4);
+  // Walked along: far wall cells, hit only sparsely by grazing beams from one place, are filled.
+  std::vector<Pose2> walk;
+  for (double x = -20.0; x <= 20.0; x += 0.37) walk.emplace_back(x, 0.1 * std::sin(x), 0.05 * std::cos(x));
+  const MapPyramid corridor_map = build_map(corridor, walk);
+  const MatchResult in_corridor =
+      match_scan(corridor_map, static_scan(corridor, truth, 1440, 0.005), truth, config);
+
+  const Eigen::Matrix3d& Cr = in_room.covariance;
+  const Eigen::Matrix3d& Cc = in_corridor.covariance;
+  // Positive definite and in metres: the room fixes the position to well under a centimetre.
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Cr).eigenvalues().minCoeff(), 0.0);
+  EXPECT_LT(std::sqrt(Cr(0, 0)), 0.01);
+  EXPECT_LT(std::sqrt(Cr(1, 1)), 0.01);
+  EXPECT_LT(std::sqrt(Cr(2, 2)), 0.01);
+  // The corridor leaves its axis (x) to the prior: tens of centimetres, while across it stays
+  // as well fixed as in the room.
+  EXPECT_GT(std::sqrt(Cc(0, 0)), 0.1);
+  EXPECT_GT(Cc(0, 0), 100.0 * Cc(1, 1));
+  EXPECT_GT(Cc(0, 0), 100.0 * Cr(0, 0));
+  EXPECT_LT(std::sqrt(Cc(1, 1)), 0.01);
+}
+
+// The covariance is in real units: it matches, within a factor of three, the scatter of poses
+// matched from independent noisy scans.
+TEST(ScanMatcher, CovarianceAgreesWithScatterOfNoisyMatches) {
+  const auto world = synthetic::room();
+  const MapPyramid maps = build_map(world, {Pose2(), Pose2(1.0, -1.0, 0.5)});
+  const Pose2 truth(0.3, 0.2, 0.1);
+  MatcherConfig config;
+  config.min_point_spacing_m = 0.0;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d reported = Eigen::Matrix3d::Zero();
+  const int n = 40;
+  for (int k = 0; k < n; ++k) {
+    const auto points = static_scan(world, truth, 720, 0.02, 100 + k);
+    const MatchResult r = match_scan(maps, points, truth, config);
+    Eigen::Vector3d e = r.T_map_base.vector() - truth.vector();
+    e.z() = wrap_angle(e.z());
+    scatter += e * e.transpose() / n;
+    reported += r.covariance / n;
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GT(reported(k, k), scatter(k, k) / 3.0) << "k " << k;
+    EXPECT_LT(reported(k, k), scatter(k, k) * 3.0) << "k " << k;
+  }
+}
+
+}  // namespace
+}  // namespace traverse::frontend

@@ -1,0 +1,41 @@
+// Helpers shared by the frontend tests: points of a synthetic scan and maps built from them.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <random>
+#include <vector>
+
+#include "scan_matcher.hpp"
+#include "synthetic_scans.hpp"
+
+namespace traverse::frontend::testing {
+
+// End points in the base frame of a full-circle scan from T_world_base (no motion), with
+// Gaussian range noise.
+inline std::vector<Eigen::Vector2d> static_scan(const synthetic::World& world,
+                                                const Pose2& T_world_base, int beams = 1440,
+                                                double noise_m = 0.0, unsigned seed = 1) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_m > 0 ? noise_m : 1.0);
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < beams; ++i) {
+    const double a = 2.0 * M_PI * i / beams;
+    const Eigen::Vector2d d(std::cos(a + T_world_base.theta()), std::sin(a + T_world_base.theta()));
+    auto r = synthetic::cast_ray(world, T_world_base.translation(), d, 40.0);
+    if (!r) continue;
+    const double range = *r + (noise_m > 0 ? noise(rng) : 0.0);
+    points.emplace_back(range * std::cos(a), range * std::sin(a));
+  }
+  return points;
+}
+
+// A map pyramid (map frame = world frame) built from scans taken at the given poses.
+inline MapPyramid build_map(const synthetic::World& world, const std::vector<Pose2>& poses,
+                            const MapConfig& config = {}) {
+  MapPyramid maps(config);
+  for (const auto& T : poses) maps.update(T, Eigen::Vector2d::Zero(), static_scan(world, T, 2880));
+  return maps;
+}
+
+}  // namespace traverse::frontend::testing

@@ -1,0 +1,82 @@
+#include "graph_test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+
+#include "lcm_log.hpp"
+#include "traverse/process_status_t.hpp"
+
+namespace traverse::graph_test {
+
+CommandResult run(const std::string& command, int timeout_s) {
+  CommandResult r;
+  const std::string full =
+      "timeout -k 5 " + std::to_string(timeout_s) + " sh -c '" + command + "' 2>&1";
+  FILE* pipe = popen(full.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe))
+    r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+std::string bin_dir() { return TRAVERSE_BIN_DIR; }
+
+std::vector<std::string> traverse_programs() {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(bin_dir())) {
+    const std::string file = e.path().filename().string();
+    if (file.rfind("traverse-", 0) == 0 && access(e.path().c_str(), X_OK) == 0) {
+      names.push_back(file.substr(9));
+    }
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::filesystem::path temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("traverse-graph-test-" + std::to_string(getpid()) + "-" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::map<std::string, int64_t> count_channels(const std::string& lcm_log) {
+  std::map<std::string, int64_t> counts;
+  LogReader reader(lcm_log);
+  while (auto ev = reader.next()) ++counts[ev->channel];
+  EXPECT_TRUE(reader.damage().empty()) << lcm_log << " is damaged";
+  return counts;
+}
+
+std::vector<StatusMessage> statuses(const std::string& lcm_log) {
+  std::vector<StatusMessage> out;
+  LogReader reader(lcm_log);
+  while (auto ev = reader.next()) {
+    if (ev->channel.rfind("STATUS_", 0) != 0) continue;
+    process_status_t st;
+    if (st.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
+    out.push_back({ev->channel, st.utime, st.pid});
+  }
+  return out;
+}
+
+std::string short_intel_log(const std::filesystem::path& dir, int lines) {
+  const std::string text = (dir / "intel-head.log").string();
+  const std::string lcm_log = (dir / "intel-head.lcmlog").string();
+  const auto r =
+      run("zcat ../shared/data/carmen/intel-corrected.log.gz | head -" + std::to_string(lines) +
+              " > " + text + " && " + bin_dir() + "/traverse-carmen " + text + " --out " + lcm_log,
+          60);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return lcm_log;
+}
+
+}  // namespace traverse::graph_test

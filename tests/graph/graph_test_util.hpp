@@ -1,0 +1,37 @@
+// Helpers of the program-wide tests: run a shell command with a time limit, read LCM logs back.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace traverse::graph_test {
+
+struct CommandResult {
+  int exit_code = -1;  // 124 when the time limit killed it
+  std::string output;  // stdout and stderr
+};
+
+// Runs `command` through /bin/sh with `timeout_s`, capturing output.
+CommandResult run(const std::string& command, int timeout_s);
+
+std::string bin_dir();                                    // TRAVERSE_BIN_DIR
+std::vector<std::string> traverse_programs();             // names of bin/traverse-*, e.g. "carmen"
+std::filesystem::path temp_dir(const std::string& name);  // fresh, under the system temp dir
+
+// Messages per channel in an LCM log; fails the test if the log is damaged.
+std::map<std::string, int64_t> count_channels(const std::string& lcm_log);
+
+struct StatusMessage {
+  std::string channel;
+  int64_t utime = 0;  // [us]
+  int32_t pid = 0;
+};
+std::vector<StatusMessage> statuses(const std::string& lcm_log);
+
+// A short LCM log made by traverse-carmen from the first `lines` lines of the Intel CARMEN log.
+std::string short_intel_log(const std::filesystem::path& dir, int lines);
+
+}  // namespace traverse::graph_test

@@ -1,0 +1,105 @@
+// The launcher's pieces without starting a graph: deployment files, stage selection, private
+// ports, and the supervisor's escalation from SIGINT to SIGKILL.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <thread>
+
+#include "config.hpp"
+#include "deployment.hpp"
+#include "graph_test_util.hpp"
+#include "supervisor.hpp"
+
+namespace traverse::launch {
+namespace {
+
+std::string write(const std::filesystem::path& dir, const std::string& name,
+                  const std::string& text) {
+  const auto path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(Deployment, LoadsSelectsAndRejects) {
+  const auto dir = graph_test::temp_dir("deploy");
+  const auto good = write(dir, "good.yaml",
+                          "processes:\n"
+                          "  - {name: a, program: traverse-a, config: configs/a.yaml}\n"
+                          "  - {name: b, program: traverse-b, args: [--x, '1']}\n"
+                          "  - {name: c, program: traverse-c}\n");
+  const Deployment d = load_deployment(good);
+  ASSERT_EQ(d.processes.size(), 3u);
+  EXPECT_EQ(d.processes[1].args, (std::vector<std::string>{"--x", "1"}));
+  std::string error;
+  const auto some = select_stages(d, "c,a", error);
+  ASSERT_TRUE(some);
+  ASSERT_EQ(some->size(), 2u);
+  EXPECT_EQ((*some)[0].name, "a");  // graph order, not list order
+  EXPECT_EQ(select_stages(d, "all", error)->size(), 3u);
+  EXPECT_FALSE(select_stages(d, "a,zzz", error));
+  EXPECT_NE(error.find("zzz"), std::string::npos);
+
+  for (const auto& [text, needle] : std::vector<std::pair<std::string, std::string>>{
+           {"processes:\n  - {name: a, program: p, confg: x}\n", "confg"},
+           {"processes:\n  - {name: a, program: p}\n  - {name: a, program: q}\n", "twice"},
+           {"processes:\n  - {name: monitor, program: p}\n", "reserved"},
+           {"processes:\n  - {program: p}\n", "name"},
+           {"stages: []\n", "stages"}}) {
+    const auto path = write(dir, "bad.yaml", text);
+    try {
+      load_deployment(path);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(PortLease, TwoLeasesNeverShareAPort) {
+  const auto dir = graph_test::temp_dir("ports");
+  // A range of two ports: two leases take both, a third finds none until one is released.
+  auto a = reserve_port(dir.string(), 31450, 31451);
+  auto b = reserve_port(dir.string(), 31450, 31451);
+  ASSERT_TRUE(a && b);
+  EXPECT_NE(a->port(), b->port());
+  EXPECT_FALSE(reserve_port(dir.string(), 31450, 31451));
+  const int freed = a->port();
+  a.reset();
+  auto c = reserve_port(dir.string(), 31450, 31451);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->port(), freed);
+  EXPECT_EQ(private_url(c->port(), 8 << 20),
+            "udpm://239.255.76.67:" + std::to_string(freed) + "?ttl=0&recv_buf_size=8388608");
+  EXPECT_EQ(recv_buf_size_of(private_url(1, 123)), 123);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Supervisor, EscalatesToSigkillForAProcessThatIgnoresSigint) {
+  const auto dir = graph_test::temp_dir("supervisor");
+  Supervisor sup;
+  std::string error;
+  ASSERT_TRUE(sup.spawn("stubborn",
+                        {"/bin/sh", "-c", "trap '' INT TERM; while :; do sleep 0.05; done"},
+                        (dir / "stubborn.log").string(), error));
+  ASSERT_TRUE(sup.spawn("polite", {"/bin/sleep", "30"}, (dir / "polite.log").string(), error));
+  ASSERT_TRUE(
+      sup.spawn("missing", {"/nonexistent/program"}, (dir / "missing.log").string(), error));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  sup.reap();
+  const Child* missing = sup.find("missing");
+  EXPECT_FALSE(missing->running);
+  EXPECT_EQ(missing->exit_code, 127);
+  EXPECT_TRUE(missing->died());
+  sup.stop({"stubborn", "polite"}, 0.3);
+  EXPECT_EQ(sup.find("polite")->term_signal, SIGINT);
+  EXPECT_FALSE(sup.find("polite")->died());
+  EXPECT_EQ(sup.find("stubborn")->term_signal, SIGKILL);
+  EXPECT_EQ(sup.find("stubborn")->last_signal_sent, "SIGKILL");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace traverse::launch
