@@ -32,6 +32,9 @@ estimate_channel() {
   local last="${1##*,}"
   case "$last" in
     frontend) echo POSE_FRONTEND ;;
+    backend) echo POSE_BACKEND ;;
+    densifier | mapper | all) echo POSE_DENSE ;;
+    backend) echo POSE_BACKEND ;;
     *) die "stage '$last' publishes no trajectory this script knows (add it to estimate_channel)" ;;
   esac
 }
@@ -88,10 +91,38 @@ evaluate() {
   fi
 }
 
-# merged_json '"key": value, ...': the evaluator's object with these fields first and the graph's
-# JSON (when run-graph printed one) under "graph".
+# True when the comma-separated stage list runs the mapper.
+runs_mapper() {
+  [[ ,$1, == *,mapper,* || $1 == all ]]
+}
+
+# cloud_evaluate WORLD_FILE OUTDIR: the mapper's cloud (OUTDIR/mapper/cloud.ply) against the
+# world's true surfaces, pillars and corridors; its JSON fields join the output (CLOUD_JSON).
+CLOUD_JSON=""
+cloud_evaluate() {
+  local world_file="$1" out="$2" rc=0
+  local name
+  name="$(basename "$world_file" .yaml)"
+  local cfg=()
+  [[ -f $ROOT/configs/cloud-eval-$name.yaml ]] && cfg=(--config "$ROOT/configs/cloud-eval-$name.yaml")
+  [[ -f $out/mapper/cloud.ply ]] || die "the mapper wrote no $out/mapper/cloud.ply"
+  "$BIN/traverse-cloud-eval" --world "$world_file" --cloud "$out/mapper/cloud.ply" "${cfg[@]}" \
+    --log "$out/run.lcmlog" >"$out/cloud-eval.out" 2>"$out/cloud-eval.log" || rc=$?
+  CLOUD_JSON="$(last_json_line "$out/cloud-eval.out")"
+  if ((rc != 0)) || [[ -z $CLOUD_JSON ]]; then
+    cat "$out/cloud-eval.log" >&2
+    die "traverse-cloud-eval failed (exit $rc)"
+  fi
+}
+
+# merged_json '"key": value, ...': the evaluator's object with these fields first, the cloud
+# evaluation's fields (when the mapper ran) after it, and the graph's JSON (when run-graph printed
+# one) under "graph".
 merged_json() {
   local head="$1" body="${EVAL_JSON#\{}"
+  if [[ -n ${CLOUD_JSON:-} ]]; then
+    body="${body%\}}, ${CLOUD_JSON#\{}"
+  fi
   if [[ -n ${GRAPH_JSON:-} ]]; then
     body="${body%\}}, \"graph\": $GRAPH_JSON}"
   fi

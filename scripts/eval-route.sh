@@ -75,6 +75,10 @@ else
   estimate="$(estimate_channel "$stages")"
   run_graph "$cache" "$out" "$stages" "$speed"
   evaluate "$out/run.lcmlog" "$estimate" POSE_GROUND_TRUTH "$out"
+  if runs_mapper "$stages"; then
+    need_programs traverse-cloud-eval
+    cloud_evaluate "$world_file" "$out"
+  fi
 fi
 echo "eval-route: $route seed $seed stages ${stages:-none}: outputs in $out" >&2
 merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -30,6 +30,9 @@ std::string validate(const BackendConfig& c) {
   if (!(c.fallback_sigma_xy_m > 0.0) || !(c.fallback_sigma_theta_rad > 0.0)) {
     return "fallback sigmas must be > 0";
   }
+  if (c.frontend_sigma_xy_m < 0.0 || c.frontend_sigma_theta_rad < 0.0) {
+    return "frontend sigmas must be >= 0 (0: no frontend edge)";
+  }
   if (c.optimize_every < 1) return "optimize_every must be >= 1";
   if (c.max_pending_scans < 1) return "max_pending_scans must be >= 1";
   if (c.smoothing.window < 1) return "smoothing.window must be >= 1";
@@ -64,8 +67,8 @@ Pose2 Backend::smooth(int64_t utime, const Pose2& T_map_base) {
   const SmoothedTrajectory s = smooth_jumps(window, config_.smoothing);
   const int n = static_cast<int>(s.poses.size());
   if (!s.replaced_steps.empty() && s.replaced_steps.back() == n - 1) ++counters_.jumps_smoothed;
-  const Pose2 smoothed = tail_.back().T_world_base *
-                         between(s.poses[n - 2].T_world_base, s.poses[n - 1].T_world_base);
+  const Pose2 smoothed =
+      tail_.back().T_world_base * between(s.poses[n - 2].T_world_base, s.poses[n - 1].T_world_base);
   last_raw_ = T_map_base;
   tail_.push_back({utime, smoothed});
   if (static_cast<int>(tail_.size()) > config_.smoothing.window + 1) tail_.erase(tail_.begin());
@@ -96,7 +99,10 @@ std::optional<BackendUpdate> Backend::add_pose(int64_t utime, const Pose2& T_map
   const int current = static_cast<int>(key_poses_.size()) - 1;
   std::vector<double> travel(key_poses_.size());
   for (std::size_t i = 0; i < travel.size(); ++i) travel[i] = key_poses_[i].travel_m;
-  const std::optional<LoopClosure> closure = loop_.add(current, graph_.poses, travel, scans_);
+  std::vector<Eigen::Matrix3d> marginals(key_poses_.size());
+  for (std::size_t i = 0; i < marginals.size(); ++i) marginals[i] = key_poses_[i].covariance;
+  const std::optional<LoopClosure> closure =
+      loop_.add(current, graph_.poses, travel, scans_, &marginals);
   if (closure) add_closure(*closure);
   if (closure || current % config_.optimize_every == 0) return optimise();
   return std::nullopt;
@@ -126,8 +132,7 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     // Link to the previous key pose: match against the last few key scans around the frontend's
     // relative motion.
     const int prev = index - 1;
-    const Pose2 T_world_guess =
-        graph_.poses[prev] * between(last_key_smoothed_, now.T_world_base);
+    const Pose2 T_world_guess = graph_.poses[prev] * between(last_key_smoothed_, now.T_world_base);
     std::vector<Eigen::Vector2d> reference;
     for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
       scans_.append_world(j, graph_.poses[j], reference);
@@ -151,6 +156,13 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     edge.T_from_to = between(graph_.poses[prev], T_world_key);
     edge.information = covariance.inverse();
     graph_.edges.push_back(edge);
+    if (config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0) {
+      const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
+      edge.T_from_to = between(last_key_smoothed_, now.T_world_base);
+      edge.information =
+          Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (sth * sth)).asDiagonal();
+      graph_.edges.push_back(edge);
+    }
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
   }
   key_poses_.push_back(key);

@@ -49,15 +49,21 @@ struct BackendConfig {
   ScanStoreConfig scans;
   // Links between consecutive key poses: a narrow search with a strong penalty, so the result
   // follows the frontend unless the scans clearly say otherwise (seed 000).
-  CorrelativeMatcherConfig link{0.01, 8, 0.002, 0.2, 0.06, 0.03, 0.2, 0.1, 0.05, 8, 400};
-  int link_chain_length = 5;         // previous key scans a new key scan is matched against
-  double min_link_response = 0.35;   // below: the frontend's relative motion is used instead
-  double fallback_sigma_xy_m = 0.05;     // its standard deviation [m]
+  CorrelativeMatcherConfig link{0.02, 8, 0.003, 0.2, 0.06, 0.03, 0.2, 0.1, 0.05, 8, 400};
+  int link_chain_length = 5;               // previous key scans a new key scan is matched against
+  double min_link_response = 0.35;         // below: the frontend's relative motion is used instead
+  double fallback_sigma_xy_m = 0.05;       // its standard deviation [m]
   double fallback_sigma_theta_rad = 0.02;  // [rad]
+  // The frontend's relative motion between consecutive key poses as a second edge beside the
+  // matched one, with these standard deviations (0: no such edge). A scan-to-map frontend is
+  // usually more precise over 1/3 s than a correlative match on a centimetre grid; this edge
+  // keeps its precision while matching and loop closures correct the drift.
+  double frontend_sigma_xy_m = 0.003;        // [m]
+  double frontend_sigma_theta_rad = 0.0005;  // [rad]
   LoopCloserConfig loop;
   SpaConfig spa;
-  int optimize_every = 1;            // key poses between optimisations (always at a closure)
-  int max_pending_scans = 100;       // scans kept while waiting for their pose
+  int optimize_every = 1;       // key poses between optimisations (always at a closure)
+  int max_pending_scans = 500;  // scans kept while waiting for their pose (~35 KB each)
 
   template <class V>
   void visit(V& v) {
@@ -70,6 +76,8 @@ struct BackendConfig {
     v("min_link_response", min_link_response);
     v("fallback_sigma_xy_m", fallback_sigma_xy_m);
     v("fallback_sigma_theta_rad", fallback_sigma_theta_rad);
+    v("frontend_sigma_xy_m", frontend_sigma_xy_m);
+    v("frontend_sigma_theta_rad", frontend_sigma_theta_rad);
     v("loop", loop);
     v("spa", spa);
     v("optimize_every", optimize_every);
@@ -81,33 +89,33 @@ struct BackendConfig {
 std::string validate(const BackendConfig& config);
 
 struct KeyPose {
-  int64_t utime = 0;        // [us] time of the frontend pose (its scan's last point)
-  double travel_m = 0.0;    // [m] distance along the smoothed trajectory
+  int64_t utime = 0;      // [us] time of the frontend pose (its scan's last point)
+  double travel_m = 0.0;  // [m] distance along the smoothed trajectory
   // Marginal covariance of (x [m], y [m], theta [rad]) in the world frame: m^2, m rad, rad^2.
   // Zero for the first key pose (it fixes the gauge).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
 struct BackendUpdate {
-  int optimisation = 0;                  // 1 for the first optimisation, +1 each
-  std::vector<int> new_key_poses;        // key pose indices added since the previous update
-  std::vector<LoopClosure> new_closures; // closures added since the previous update
+  int optimisation = 0;                   // 1 for the first optimisation, +1 each
+  std::vector<int> new_key_poses;         // key pose indices added since the previous update
+  std::vector<LoopClosure> new_closures;  // closures added since the previous update
   SpaResult spa;
   double optimisation_s = 0.0;  // [s] wall time of SPA
   double marginals_s = 0.0;     // [s] wall time of the covariance recovery
 };
 
 struct BackendCounters {
-  long poses = 0;               // frontend poses received
-  long jumps_smoothed = 0;      // frontend steps replaced by the average
-  long scans = 0;               // scans received
+  long poses = 0;                   // frontend poses received
+  long jumps_smoothed = 0;          // frontend steps replaced by the average
+  long scans = 0;                   // scans received
   long key_poses_without_scan = 0;  // key pose deferred: its scan was missing
-  long links_matched = 0;       // consecutive links from correlative matching
-  long links_fallback = 0;      // ... from the frontend's motion (response too low)
+  long links_matched = 0;           // consecutive links from correlative matching
+  long links_fallback = 0;          // ... from the frontend's motion (response too low)
   long optimisations = 0;
-  long optimisations_failed = 0;  // not converged or covariance not recovered
-  double last_optimisation_s = 0.0;  // [s]
-  double total_optimisation_s = 0.0; // [s]
+  long optimisations_failed = 0;      // not converged or covariance not recovered
+  double last_optimisation_s = 0.0;   // [s]
+  double total_optimisation_s = 0.0;  // [s]
 };
 
 class Backend {
@@ -146,14 +154,14 @@ class Backend {
   BackendCounters counters_;
 
   std::deque<PlanarScan> pending_scans_;
-  std::vector<StampedPose> tail_;      // the last smoothed poses (window + 1)
-  Pose2 last_raw_;                     // the previous frontend pose
-  std::vector<StampedPose> since_key_; // smoothed poses since the last key pose (inclusive)
+  std::vector<StampedPose> tail_;       // the last smoothed poses (window + 1)
+  Pose2 last_raw_;                      // the previous frontend pose
+  std::vector<StampedPose> since_key_;  // smoothed poses since the last key pose (inclusive)
   double travel_m_ = 0.0;
 
   PoseGraph graph_;
   std::vector<KeyPose> key_poses_;
-  Pose2 last_key_smoothed_;            // smoothed pose of the last key pose
+  Pose2 last_key_smoothed_;  // smoothed pose of the last key pose
   ScanStore scans_;
   std::vector<LoopClosure> closures_;
   int first_unreported_key_ = 0;

@@ -63,7 +63,8 @@ bool BackendNode::changed(int i) const {
   }
   const Eigen::Vector3d v = backend_.key_poses()[i].covariance.diagonal();
   for (int k = 0; k < 3; ++k) {
-    if (std::abs(v[k] - p.variances[k]) > config_.publish_covariance_change * std::abs(p.variances[k]))
+    if (std::abs(v[k] - p.variances[k]) >
+        config_.publish_covariance_change * std::abs(p.variances[k]))
       return true;
   }
   return false;
@@ -124,7 +125,8 @@ void BackendNode::publish(const BackendUpdate& update) {
       }
     }
     msg.n_closures = static_cast<int32_t>(msg.closures.size());
-    max_message_bytes_ = std::max(max_message_bytes_, static_cast<std::size_t>(msg.getEncodedSize()));
+    max_message_bytes_ =
+        std::max(max_message_bytes_, static_cast<std::size_t>(msg.getEncodedSize()));
     bus_.publish(config_.key_poses_channel, msg);
     ++messages_;
   }
@@ -161,6 +163,7 @@ void BackendNode::report_counters() {
   counters_("loop_rejected_response", static_cast<double>(l.rejected_response));
   counters_("loop_rejected_ambiguous", static_cast<double>(l.rejected_ambiguous));
   counters_("loop_rejected_covariance", static_cast<double>(l.rejected_covariance));
+  counters_("loop_rejected_inconsistent", static_cast<double>(l.rejected_inconsistent));
   counters_("optimisations", static_cast<double>(c.optimisations));
   counters_("optimisations_failed", static_cast<double>(c.optimisations_failed));
   counters_("optimisation_last_s", c.last_optimisation_s);

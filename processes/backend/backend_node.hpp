@@ -21,9 +21,9 @@ struct BackendNodeConfig {
   std::string pose_channel = channels::kPoseFrontend;
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
-  int max_poses_per_message = 400;    // 112 bytes each: 400 keep a part under 64 KB
-  double publish_move_m = 0.001;      // a key pose moved farther than this is republished [m]
-  double publish_turn_rad = 0.0005;   // ... or turned more than this [rad]
+  int max_poses_per_message = 400;          // 112 bytes each: 400 keep a part under 64 KB
+  double publish_move_m = 0.001;            // a key pose moved farther than this is republished [m]
+  double publish_turn_rad = 0.0005;         // ... or turned more than this [rad]
   double publish_covariance_change = 0.01;  // ... or a variance changed by this fraction
   BackendConfig backend;
 

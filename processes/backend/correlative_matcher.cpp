@@ -24,7 +24,7 @@ class LookupTable {
     height_ = static_cast<int>(std::ceil((hi.y() - lo.y() + 2 * margin) / resolution)) + 1;
     fine_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
     const int radius = static_cast<int>(std::ceil(3.0 * sigma / resolution));
-    for (const auto& p : points) stamp(p, radius, sigma);
+    stamp_all(points, radius, sigma);
     build_coarse(coarse_factor);
   }
 
@@ -45,15 +45,29 @@ class LookupTable {
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
   std::size_t at(int x, int y) const { return static_cast<std::size_t>(y) * width_ + x; }
 
-  void stamp(const Eigen::Vector2d& p, int radius, double sigma) {
-    const Eigen::Vector2i c = index(p);
-    for (int y = c.y() - radius; y <= c.y() + radius; ++y) {
-      for (int x = c.x() - radius; x <= c.x() + radius; ++x) {
-        if (!inside(x, y)) continue;
-        const Eigen::Vector2d centre = origin_ + resolution_ * Eigen::Vector2d(x + 0.5, y + 0.5);
-        const double d2 = (centre - p).squaredNorm();
-        float& v = fine_[at(x, y)];
-        v = std::max(v, static_cast<float>(std::exp(-0.5 * d2 / (sigma * sigma))));
+  // The kernel is evaluated once per table on cell offsets; a point is snapped to its cell (the
+  // cell is a fraction of the kernel width).
+  void stamp_all(const std::vector<Eigen::Vector2d>& points, int radius, double sigma) {
+    const int side = 2 * radius + 1;
+    std::vector<float> kernel(static_cast<std::size_t>(side) * side);
+    for (int dy = -radius; dy <= radius; ++dy) {
+      for (int dx = -radius; dx <= radius; ++dx) {
+        const double d2 = resolution_ * resolution_ * (dx * dx + dy * dy);
+        kernel[(dy + radius) * side + dx + radius] =
+            static_cast<float>(std::exp(-0.5 * d2 / (sigma * sigma)));
+      }
+    }
+    for (const auto& p : points) {
+      const Eigen::Vector2i c = index(p);
+      for (int dy = -radius; dy <= radius; ++dy) {
+        const int y = c.y() + dy;
+        if (y < 0 || y >= height_) continue;
+        for (int dx = -radius; dx <= radius; ++dx) {
+          const int x = c.x() + dx;
+          if (x < 0 || x >= width_) continue;
+          float& v = fine_[at(x, y)];
+          v = std::max(v, kernel[(dy + radius) * side + dx + radius]);
+        }
       }
     }
   }
@@ -86,9 +100,9 @@ class LookupTable {
 };
 
 struct Candidate {
-  double bound;      // upper bound of the (penalised or raw) response in the block
-  int angle;         // heading step index in [0, 2A]
-  int i0, j0;        // first translation step of the block, in [-W, W]
+  double bound;  // upper bound of the (penalised or raw) response in the block
+  int angle;     // heading step index in [0, 2A]
+  int i0, j0;    // first translation step of the block, in [-W, W]
 };
 
 }  // namespace
@@ -186,9 +200,24 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
   result.valid = true;
   result.response = best;
   result.raw_response = fine_sum(best_a, best_i, best_j);
-  const double theta = T_world_guess.theta() + (best_a - A) * step;
-  result.T_world_query =
-      Pose2(T_world_guess.x() + best_i * res, T_world_guess.y() + best_j * res, theta);
+  // Sub-step refinement: the vertex of a parabola through the best pose and its two neighbours,
+  // per axis (the table is smooth at the kernel scale, so the peak is locally quadratic).
+  const auto score = [&](int a, int i, int j) {
+    if (a < 0 || a > 2 * A || std::abs(i) > W || std::abs(j) > W) return -1.0;
+    return fine_sum(a, i, j) * penalty(i * i + j * j, a);
+  };
+  const auto vertex = [&](double minus, double plus) {
+    const double curvature = minus - 2.0 * best + plus;
+    if (minus < 0.0 || plus < 0.0 || curvature >= 0.0) return 0.0;
+    return std::clamp(0.5 * (minus - plus) / curvature, -0.5, 0.5);
+  };
+  const double di = vertex(score(best_a, best_i - 1, best_j), score(best_a, best_i + 1, best_j));
+  const double dj = vertex(score(best_a, best_i, best_j - 1), score(best_a, best_i, best_j + 1));
+  const double da = vertex(score(best_a - 1, best_i, best_j), score(best_a + 1, best_i, best_j));
+  result.evaluations += 6;
+  const double theta = T_world_guess.theta() + (best_a + da - A) * step;
+  result.T_world_query = Pose2(T_world_guess.x() + (best_i + di) * res,
+                               T_world_guess.y() + (best_j + dj) * res, theta);
 
   // Second peak: the same search on raw responses, skipping poses near the best translation.
   if (second_peak_exclusion_m > 0.0) {
@@ -233,8 +262,8 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
     mean /= wsum;
     result.covariance = second_moment / wsum - mean * mean.transpose();
   } else {  // nothing overlaps anywhere: the whole window is equally likely
-    result.covariance = Eigen::Vector3d(W * W * res * res, W * W * res * res, A * A * step * step)
-                            .asDiagonal();
+    result.covariance =
+        Eigen::Vector3d(W * W * res * res, W * W * res * res, A * A * step * step).asDiagonal();
   }
   // The discrete steps bound what the search can resolve: at least a quarter step squared.
   result.covariance(0, 0) += 0.25 * res * res;

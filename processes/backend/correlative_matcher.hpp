@@ -34,7 +34,7 @@ struct CorrelativeMatcherConfig {
   double angular_window_rad = 0.1;  // search +- this around the guess heading [rad]
   double kernel_sigma_m = 0.04;     // blur of the lookup table (range noise + cell size) [m]
   double penalty_sigma_xy_m = 0.5;  // distance from the guess at which the response drops to 61 %
-  double penalty_sigma_theta_rad = 0.3;  // same for the heading [rad]
+  double penalty_sigma_theta_rad = 0.3;    // same for the heading [rad]
   double covariance_response_drop = 0.05;  // poses within this of the best response enter the
                                            // covariance [response units, 0..1]
   int covariance_window_cells = 10;        // ... within +- this many fine steps of the best
@@ -60,10 +60,10 @@ struct CorrelativeMatcherConfig {
 std::string validate(const CorrelativeMatcherConfig& config);
 
 struct MatchResult {
-  bool valid = false;          // false: no reference or query points
-  Pose2 T_world_query;         // best pose of the query scan
-  double response = 0.0;       // penalised response of the best pose [0..1]
-  double raw_response = 0.0;   // its response without the penalty [0..1]
+  bool valid = false;         // false: no reference or query points
+  Pose2 T_world_query;        // best pose of the query scan
+  double response = 0.0;      // penalised response of the best pose [0..1]
+  double raw_response = 0.0;  // its response without the penalty [0..1]
   // Best raw response among poses farther than `exclusion_m` from the best (only when asked);
   // a value close to raw_response means the scene is ambiguous (repeated rooms).
   double second_peak_response = 0.0;

@@ -1,5 +1,6 @@
 #include "loop_closer.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
@@ -24,9 +25,9 @@ std::string validate(const LoopCloserConfig& c) {
 LoopCloser::LoopCloser(LoopCloserConfig config)
     : config_(std::move(config)), coarse_(config_.coarse), fine_(config_.fine) {}
 
-std::optional<LoopClosure> LoopCloser::try_candidate(int current, int chain_first, int chain_last,
-                                                     const std::vector<Pose2>& poses,
-                                                     const ScanStore& scans) {
+std::optional<LoopClosure> LoopCloser::try_candidate(
+    int current, int chain_first, int chain_last, const std::vector<Pose2>& poses,
+    const ScanStore& scans, const std::vector<Eigen::Matrix3d>* marginals) {
   ++counters_.candidates;
   std::vector<Eigen::Vector2d> reference;
   for (int j = chain_first; j <= chain_last; ++j) scans.append_world(j, poses[j], reference);
@@ -66,6 +67,17 @@ std::optional<LoopClosure> LoopCloser::try_candidate(int current, int chain_firs
     if (d < nearest) nearest = d, closure.from = j;
   }
   closure.T_from_to = between(poses[closure.from], T_world_current);
+  // 5. The implied correction of the current pose must fit the graph's own uncertainty.
+  if (marginals && config_.max_correction_mahalanobis > 0.0) {
+    const Eigen::Vector3d d(T_world_current.x() - poses[current].x(),
+                            T_world_current.y() - poses[current].y(),
+                            wrap_angle(T_world_current.theta() - poses[current].theta()));
+    const Eigen::Matrix3d S = fine.covariance + (*marginals)[closure.from] + (*marginals)[current];
+    if (std::sqrt(d.dot(S.ldlt().solve(d))) > config_.max_correction_mahalanobis) {
+      ++counters_.rejected_inconsistent;
+      return std::nullopt;
+    }
+  }
   // The matcher's covariance is in the world frame; the edge error's translation is in the frame
   // of the `to` pose.
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
@@ -78,7 +90,8 @@ std::optional<LoopClosure> LoopCloser::try_candidate(int current, int chain_firs
 
 std::optional<LoopClosure> LoopCloser::add(int current, const std::vector<Pose2>& poses,
                                            const std::vector<double>& travel_m,
-                                           const ScanStore& scans) {
+                                           const ScanStore& scans,
+                                           const std::vector<Eigen::Matrix3d>* marginals) {
   // Old key poses near the newest one, and the nearest of them.
   const Eigen::Vector2d p = poses[current].translation();
   const auto old_and_within = [&](int j, double radius) {
@@ -120,7 +133,7 @@ std::optional<LoopClosure> LoopCloser::add(int current, const std::vector<Pose2>
   chain_first_ = first;
   chain_last_ = last;
   ++episode_candidates_;
-  if (auto candidate = try_candidate(current, first, last, poses, scans)) {
+  if (auto candidate = try_candidate(current, first, last, poses, scans, marginals)) {
     if (!best_ || candidate->response > best_->response) best_ = candidate;
   }
   if (ended) return ended;

@@ -14,7 +14,8 @@
 //  2. the scene is not ambiguous: the best response at least ambiguity_exclusion_m away from the
 //     peak is below max_ambiguity_ratio times the peak (repeated rooms, corridors),
 //  3. a fine search around the coarse peak has a response over min_fine_response, and
-//  4. the fine covariance is tight (standard deviations under max_sigma_xy_m, max_sigma_theta_rad).
+//  4. the fine covariance is tight (standard deviations under max_sigma_xy_m, max_sigma_theta_rad),
+//  5. and the correction it implies for the current pose fits the graph's marginal covariances.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,19 +29,28 @@
 namespace traverse::backend {
 
 struct LoopCloserConfig {
-  double search_radius_m = 2.5;    // old key poses this close to the newest start an episode [m]
-  double min_travel_m = 10.0;      // ... if at least this far back along the trajectory [m]
-  double chain_radius_m = 8.0;     // chain: old key poses within this of the newest pose [m]
-  int max_chain_length = 30;       // key scans in a chain at most
-  int max_candidates = 9;          // current key scans tried per episode (~3 s at 3 Hz)
-  double min_coarse_response = 0.5;     // [0..1]
-  double min_fine_response = 0.6;       // [0..1]
-  double max_ambiguity_ratio = 0.85;    // second peak / peak above this: ambiguous, rejected
-  double ambiguity_exclusion_m = 0.6;   // the second peak lies at least this far from the peak [m]
-  double max_sigma_xy_m = 0.08;         // largest standard deviation of the fine match [m]
-  double max_sigma_theta_rad = 0.02;    // [rad]
+  double search_radius_m = 2.5;       // old key poses this close to the newest start an episode [m]
+  double min_travel_m = 10.0;         // ... if at least this far back along the trajectory [m]
+  double chain_radius_m = 8.0;        // chain: old key poses within this of the newest pose [m]
+  int max_chain_length = 30;          // key scans in a chain at most
+  int max_candidates = 9;             // current key scans tried per episode (~3 s at 3 Hz)
+  double min_coarse_response = 0.5;   // [0..1]
+  double min_fine_response = 0.6;     // [0..1]
+  double max_ambiguity_ratio = 0.85;  // second peak / peak above this: ambiguous, rejected
+  double ambiguity_exclusion_m = 0.3;  // the second peak lies at least this far from the peak [m]
+  double max_sigma_xy_m = 0.08;        // largest standard deviation of the fine match [m]
+  double max_sigma_theta_rad = 0.02;   // [rad]
+  // 5. The correction the closure implies for the current pose, against the sum of the match's
+  //    covariance and the marginals of both key poses: above this Mahalanobis distance the
+  //    closure contradicts the graph (0: not checked).
+  double max_correction_mahalanobis = 5.0;
+  // Matcher settings in field order: resolution_m, coarse_factor, angle_step_rad,
+  // linear_window_m, angular_window_rad, kernel_sigma_m, penalty_sigma_xy_m,
+  // penalty_sigma_theta_rad, covariance_response_drop, covariance_window_cells, max_query_points.
+  // Coarse: a wide window (the drift a loop can carry) on a 5 cm grid, almost no penalty.
   CorrelativeMatcherConfig coarse{0.05, 8, 0.01, 2.0, 0.35, 0.06, 10.0, 2.0, 0.05, 10, 300};
-  CorrelativeMatcherConfig fine{0.01, 4, 0.001, 0.12, 0.03, 0.03, 10.0, 2.0, 0.05, 8, 400};
+  // Fine: around the coarse peak on a 2 cm grid.
+  CorrelativeMatcherConfig fine{0.02, 4, 0.002, 0.12, 0.03, 0.03, 10.0, 2.0, 0.05, 8, 400};
 
   template <class V>
   void visit(V& v) {
@@ -55,6 +65,7 @@ struct LoopCloserConfig {
     v("ambiguity_exclusion_m", ambiguity_exclusion_m);
     v("max_sigma_xy_m", max_sigma_xy_m);
     v("max_sigma_theta_rad", max_sigma_theta_rad);
+    v("max_correction_mahalanobis", max_correction_mahalanobis);
     v("coarse", coarse);
     v("fine", fine);
   }
@@ -69,17 +80,18 @@ struct LoopClosure {
   // Covariance of the measurement on (x [m], y [m], theta [rad]) in the frame of `to`, as the
   // pose graph's edge error is expressed: m^2, m rad, rad^2.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
-  double response = 0.0;       // fine raw response [0..1]
-  double second_peak = 0.0;    // coarse ambiguity ratio (second peak / peak)
-  int candidates_tried = 0;    // candidates of the episode
+  double response = 0.0;     // fine raw response [0..1]
+  double second_peak = 0.0;  // coarse ambiguity ratio (second peak / peak)
+  int candidates_tried = 0;  // candidates of the episode
 };
 
 struct LoopCloserCounters {
   long episodes = 0;
-  long candidates = 0;             // key scans matched against a chain
-  long rejected_response = 0;      // coarse or fine response too low
+  long candidates = 0;         // key scans matched against a chain
+  long rejected_response = 0;  // coarse or fine response too low
   long rejected_ambiguous = 0;
   long rejected_covariance = 0;
+  long rejected_inconsistent = 0;  // correction too large for the marginals
   long closures = 0;
 };
 
@@ -89,18 +101,20 @@ class LoopCloser {
   explicit LoopCloser(LoopCloserConfig config);
 
   // Key pose `current` is the newest; poses are the current estimates T_world_base of all key
-  // poses and travel_m their distance along the trajectory [m]. Returns a closure when this call
-  // ends an episode that had an accepted candidate.
+  // poses and travel_m their distance along the trajectory [m]; marginals (world frame, per key
+  // pose) enable check 5. Returns a closure when this call ends an episode that had an accepted
+  // candidate.
   std::optional<LoopClosure> add(int current, const std::vector<Pose2>& poses,
-                                 const std::vector<double>& travel_m, const ScanStore& scans);
+                                 const std::vector<double>& travel_m, const ScanStore& scans,
+                                 const std::vector<Eigen::Matrix3d>* marginals = nullptr);
   // Ends the open episode (end of data).
   std::optional<LoopClosure> finish();
 
   // One candidate: the current key scan against the chain [chain_first, chain_last]; nullopt when
   // a check rejects it (counted). Exposed for tests.
   std::optional<LoopClosure> try_candidate(int current, int chain_first, int chain_last,
-                                           const std::vector<Pose2>& poses,
-                                           const ScanStore& scans);
+                                           const std::vector<Pose2>& poses, const ScanStore& scans,
+                                           const std::vector<Eigen::Matrix3d>* marginals = nullptr);
 
   const LoopCloserCounters& counters() const { return counters_; }
 

@@ -48,7 +48,8 @@ int ScanStore::add(std::vector<Eigen::Vector2f> points_base) {
 
 void ScanStore::append_world(int index, const Pose2& T_world_base,
                              std::vector<Eigen::Vector2d>& out) const {
-  for (const auto& p : scans_[index]) out.push_back(T_world_base * Eigen::Vector2d(p.cast<double>()));
+  for (const auto& p : scans_[index])
+    out.push_back(T_world_base * Eigen::Vector2d(p.cast<double>()));
 }
 
 std::vector<Eigen::Vector2d> ScanStore::points_d(int index) const {

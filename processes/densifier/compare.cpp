@@ -97,10 +97,12 @@ int main(int argc, char** argv) {
         // Odometry-style drift: 1 % of the step's travel and 0.5 % of its turn, plus a floor.
         const Pose2 step = traverse::between(truth.back(), T);
         const double d = step.translation().norm(), a = std::abs(step.theta());
-        odo = odo * Pose2(step.x() + rng.normal(0.01 * d + 5e-5), step.y() + rng.normal(0.01 * d + 5e-5),
+        odo = odo * Pose2(step.x() + rng.normal(0.01 * d + 5e-5),
+                          step.y() + rng.normal(0.01 * d + 5e-5),
                           step.theta() + rng.normal(0.005 * a + 2e-5));
       }
-      still.push_back(i > 0 && (T.translation() - truth.back().translation()).norm() * rate_hz < 0.01);
+      still.push_back(i > 0 &&
+                      (T.translation() - truth.back().translation()).norm() * rate_hz < 0.01);
       truth.push_back(T);
       dense.push_back({utime, odo * Pose2(rng.normal(1e-3), rng.normal(1e-3), rng.normal(3e-4))});
       if (i % key_every == 0) {

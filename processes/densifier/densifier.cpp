@@ -1,7 +1,7 @@
 #include "densifier.hpp"
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -21,7 +21,8 @@ std::optional<Pose2> interpolate_at(const std::vector<StampedPose>& poses, int64
                              [](const StampedPose& p, int64_t t) { return p.utime < t; });
   if (hi->utime == utime) return hi->T_world_base;
   auto lo = hi - 1;
-  const double s = static_cast<double>(utime - lo->utime) / static_cast<double>(hi->utime - lo->utime);
+  const double s =
+      static_cast<double>(utime - lo->utime) / static_cast<double>(hi->utime - lo->utime);
   return interpolate(lo->T_world_base, hi->T_world_base, s);
 }
 
@@ -52,8 +53,7 @@ std::vector<StampedPose> correct_paper(const std::vector<StampedPose>& dense, co
   std::vector<StampedPose> out;
   out.reserve(dense.size());
   for (const StampedPose& p : dense) {
-    const double s =
-        t_span > 0 ? static_cast<double>(p.utime - dense.front().utime) / t_span : 0.0;
+    const double s = t_span > 0 ? static_cast<double>(p.utime - dense.front().utime) / t_span : 0.0;
     const Eigen::Vector2d q =
         K_a.translation() + scale * R * (p.T_world_base.translation() - D_a.translation());
     const double theta = p.T_world_base.theta() + heading_correction(D_a, D_b, K_a, K_b, s);
@@ -109,7 +109,8 @@ std::vector<StampedPose> correct_segment(const std::vector<StampedPose>& dense, 
 
 Densifier::Densifier(const DensifierConfig& config) : config_(config) {
   auto mode = parse_mode(config.mode);
-  if (!mode) throw std::invalid_argument("densifier mode must be paper or rigid, not " + config.mode);
+  if (!mode)
+    throw std::invalid_argument("densifier mode must be paper or rigid, not " + config.mode);
   mode_ = *mode;
 }
 
@@ -172,12 +173,12 @@ void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it,
   if (next == keys_.end() || !it->second.placed || !next->second.placed) return;
   const std::vector<StampedPose> dense = dense_between(it->first, next->first);
   if (dense.size() < 2) return;
-  std::vector<StampedPose> poses = correct_segment(dense, it->second.key.T_world_base,
-                                                   next->second.key.T_world_base, mode_,
-                                                   config_.turn_lever_m);
+  std::vector<StampedPose> poses =
+      correct_segment(dense, it->second.key.T_world_base, next->second.key.T_world_base, mode_,
+                      config_.turn_lever_m);
   SegmentState& seg = segments_[it->first];
-  bool changed = seg.revision < 0 || seg.utime_last != next->first ||
-                 seg.poses.size() != poses.size();
+  bool changed =
+      seg.revision < 0 || seg.utime_last != next->first || seg.poses.size() != poses.size();
   for (std::size_t i = 0; !changed && i < poses.size(); ++i) {
     const Pose2& p = poses[i].T_world_base;
     const Pose2& q = seg.poses[i].T_world_base;

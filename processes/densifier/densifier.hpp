@@ -32,11 +32,11 @@ namespace traverse::densifier {
 enum class Mode { kPaper, kRigid };
 
 struct DensifierConfig {
-  std::string mode = "rigid";          // "rigid" (interpolated rigid correction) or "paper"
-  double turn_lever_m = 0.5;           // [m/rad] a turn of 1 rad counts as this much travel
-  double republish_threshold_m = 1e-4;     // [m] a segment moving less is not sent again
-  double republish_threshold_rad = 1e-5;   // [rad] same for headings
-  std::string parent_frame = "world";  // frame of the published poses
+  std::string mode = "rigid";                  // "rigid" (interpolated rigid correction) or "paper"
+  double turn_lever_m = 0.5;                   // [m/rad] a turn of 1 rad counts as this much travel
+  double republish_threshold_m = 1e-4;         // [m] a segment moving less is not sent again
+  double republish_threshold_rad = 1e-5;       // [rad] same for headings
+  std::string parent_frame = "world";          // frame of the published poses
   std::string key_pose_channel = "KEY_POSES";  // key_poses_t from the backend
   template <class V>
   void visit(V& v) {
@@ -58,8 +58,8 @@ struct StampedPose {
 };
 
 struct KeyPose {
-  int64_t id = 0;     // backend's key pose id
-  int64_t utime = 0;  // [us] time of the scan the key pose belongs to
+  int64_t id = 0;      // backend's key pose id
+  int64_t utime = 0;   // [us] time of the scan the key pose belongs to
   Pose2 T_world_base;  // optimised pose
 };
 

@@ -7,8 +7,7 @@ namespace traverse::densifier {
 
 DensifierNode::DensifierNode(Bus& bus, const DensifierConfig& config, CounterSink counters)
     : bus_(bus), config_(config), densifier_(config), counters_(std::move(counters)) {
-  bus_.subscribe<pose2d_t>(channels::kPoseFrontend,
-                           [this](const pose2d_t& m) { on_frontend(m); });
+  bus_.subscribe<pose2d_t>(channels::kPoseFrontend, [this](const pose2d_t& m) { on_frontend(m); });
   bus_.subscribe<key_poses_t>(
       config_.key_pose_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
 }

@@ -1,5 +1,6 @@
 // traverse-densifier: bends the dense frontend trajectory to the backend's optimised key poses
-// (seed 000) and publishes the corrected trajectory as it grows and the segments loop closures move.
+// (seed 000) and publishes the corrected trajectory as it grows and the segments loop closures
+// move.
 #include <spdlog/spdlog.h>
 
 #include "densifier_node.hpp"

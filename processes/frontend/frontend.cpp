@@ -1,11 +1,11 @@
 #include "frontend.hpp"
 
-#include "deskew.hpp"
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
+
+#include "deskew.hpp"
 
 namespace traverse::frontend {
 namespace {
@@ -63,7 +63,8 @@ void Frontend::valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& poin
   const std::size_t n = scan.ranges.size();
   double lo = config_.matcher.min_range_m, hi = config_.matcher.max_range_m;
   if (std::isfinite(scan.range_min) && scan.range_min > lo) lo = scan.range_min;
-  if (std::isfinite(scan.range_max) && scan.range_max > 0.0 && scan.range_max < hi) hi = scan.range_max;
+  if (std::isfinite(scan.range_max) && scan.range_max > 0.0 && scan.range_max < hi)
+    hi = scan.range_max;
   const double duration = static_cast<double>(scan.utime_last - scan.utime_first);
   points_base.clear();
   utimes.clear();
@@ -71,14 +72,27 @@ void Frontend::valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& poin
     counters_.readings_invalid += static_cast<int64_t>(n);
     return;
   }
+  // Beam directions in the base frame, computed once per scan geometry (it rarely changes).
+  if (beam_n_ != n || beam_angle_first_ != scan.angle_first ||
+      beam_angle_step_ != scan.angle_step) {
+    beam_directions_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double a = scan.angle_first + static_cast<double>(i) * scan.angle_step;
+      beam_directions_[i] = T_base_laser_.rotation() * Eigen::Vector2d(std::cos(a), std::sin(a));
+    }
+    beam_n_ = n;
+    beam_angle_first_ = scan.angle_first;
+    beam_angle_step_ = scan.angle_step;
+  }
+  points_base.reserve(n);
+  utimes.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double r = scan.ranges[i];
     if (!std::isfinite(r) || r <= 0.0 || r < lo || r > hi) {
       ++counters_.readings_invalid;
       continue;
     }
-    const double a = scan.angle_first + static_cast<double>(i) * scan.angle_step;
-    points_base.push_back(T_base_laser_ * Eigen::Vector2d(r * std::cos(a), r * std::sin(a)));
+    points_base.push_back(T_base_laser_.translation() + r * beam_directions_[i]);
     const double s = n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 1.0;
     utimes.push_back(scan.utime_first + std::llround(s * duration));
   }
@@ -102,10 +116,24 @@ void Frontend::deskew(std::vector<Eigen::Vector2d>& points_base, const std::vect
                       int64_t utime_ref, bool use_imu) const {
   if (!config_.deskew.enabled) return;
   // Heading change from the IMU's yaw rate, or from the constant angular velocity without IMU.
+  // The IMU's integral is evaluated at kKnots times across the sweep and interpolated linearly
+  // per point (the integral is smooth: a few samples fall within a sweep), instead of a search
+  // in the IMU buffer for each of thousands of points.
+  constexpr int kKnots = 33;
   const double omega = velocity_.z();
+  const int64_t t0 = utimes.empty() ? utime_ref : std::min(utimes.front(), utime_ref);
+  const double span = static_cast<double>(std::max<int64_t>(1, utime_ref - t0));
+  std::array<double, kKnots> knots{};
+  if (use_imu) {
+    for (int k = 0; k < kKnots; ++k) {
+      knots[k] = yaw_.heading_change(utime_ref, t0 + std::llround(span * k / (kKnots - 1)));
+    }
+  }
   auto heading_change = [&](int64_t t) {
-    return use_imu ? yaw_.heading_change(utime_ref, t)
-                   : omega * 1e-6 * static_cast<double>(t - utime_ref);
+    if (!use_imu) return omega * 1e-6 * static_cast<double>(t - utime_ref);
+    const double x = std::clamp(static_cast<double>(t - t0) / span, 0.0, 1.0) * (kKnots - 1);
+    const int k = std::min(kKnots - 2, static_cast<int>(x));
+    return knots[k] + (x - k) * (knots[k + 1] - knots[k]);
   };
   deskew_points(points_base, utimes, utime_ref, heading_change, velocity_.head<2>(),
                 config_.deskew.translation);
@@ -150,8 +178,8 @@ FrontendResult Frontend::process(const Scan& scan) {
     ++counters_.scans_dropped_time;
     return result;
   }
-  std::vector<Eigen::Vector2d> points;
-  std::vector<int64_t> utimes;
+  std::vector<Eigen::Vector2d>& points = points_buffer_;
+  std::vector<int64_t>& utimes = utimes_buffer_;
   valid_points(scan, points, utimes);
   result.valid_points = static_cast<int>(points.size());
   const bool use_imu = imu_active(scan);

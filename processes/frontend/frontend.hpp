@@ -12,7 +12,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -27,12 +26,12 @@ namespace traverse::frontend {
 // One planar sweep, as planar_scan_t carries it. Beam i is measured at
 // utime_first + i (utime_last - utime_first) / (n - 1) along angle_first + i angle_step.
 struct Scan {
-  int64_t utime_first = 0;  // [us]
-  int64_t utime_last = 0;   // [us]
-  double angle_first = 0.0; // [rad] in the laser frame
-  double angle_step = 0.0;  // [rad]
-  double range_min = 0.0;   // [m]
-  double range_max = 0.0;   // [m]
+  int64_t utime_first = 0;    // [us]
+  int64_t utime_last = 0;     // [us]
+  double angle_first = 0.0;   // [rad] in the laser frame
+  double angle_step = 0.0;    // [rad]
+  double range_min = 0.0;     // [m]
+  double range_max = 0.0;     // [m]
   std::vector<float> ranges;  // [m]
 };
 
@@ -59,14 +58,14 @@ struct FrontendResult {
 struct FrontendCounters {
   int64_t scans_received = 0;
   int64_t scans_matched = 0;
-  int64_t scans_predicted = 0;       // too few valid points
-  int64_t scans_searched = 0;        // matches that needed the recovery search
-  int64_t scans_dropped_time = 0;    // time going backwards or utime_last < utime_first
-  int64_t readings_invalid = 0;      // NaN, zero or out-of-range readings ignored
+  int64_t scans_predicted = 0;     // too few valid points
+  int64_t scans_searched = 0;      // matches that needed the recovery search
+  int64_t scans_dropped_time = 0;  // time going backwards or utime_last < utime_first
+  int64_t readings_invalid = 0;    // NaN, zero or out-of-range readings ignored
   int64_t map_updates = 0;
   int64_t map_tiles_evicted = 0;
   int64_t imu_samples = 0;
-  int64_t imu_dropped_time = 0;      // IMU samples not after the previous one
+  int64_t imu_dropped_time = 0;  // IMU samples not after the previous one
 };
 
 class Frontend {
@@ -103,12 +102,19 @@ class Frontend {
   FrontendCounters counters_;
 
   bool initialised_ = false;
-  int64_t last_utime_ = 0;       // [us] of the last pose
-  int64_t last_interval_us_ = 0; // [us] between the last two poses
+  int64_t last_utime_ = 0;        // [us] of the last pose
+  int64_t last_interval_us_ = 0;  // [us] between the last two poses
   Pose2 T_map_base_last_;
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  // (vx [m/s], vy [m/s], omega [rad/s]) base
   Pose2 T_map_base_last_update_;
   Eigen::Matrix3d covariance_last_ = Eigen::Matrix3d::Zero();
+
+  // Reused between scans: beam directions of the last scan geometry, and point buffers.
+  std::size_t beam_n_ = 0;
+  double beam_angle_first_ = 0.0, beam_angle_step_ = 0.0;
+  std::vector<Eigen::Vector2d> beam_directions_;
+  std::vector<Eigen::Vector2d> points_buffer_;
+  std::vector<int64_t> utimes_buffer_;
 };
 
 }  // namespace traverse::frontend

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "channels.hpp"
@@ -11,12 +12,12 @@ namespace traverse::frontend {
 
 // Occupancy grid pyramid (Hector SLAM section IV.A, map update section IV.C).
 struct MapConfig {
-  double resolution_m = 0.05;  // finest level; level k has resolution_m * 2^k
-  int levels = 3;              // pyramid depth, 1 = a single grid
-  double p_occupied = 0.9;     // probability an end point's cell is occupied (Hector 0.9)
-  double p_free = 0.4;         // probability a traversed cell is occupied (Hector 0.4)
-  double update_distance_m = 0.2;  // update the map when the pose moved this far ...
-  double update_angle_rad = 0.1;   // ... or turned this much since the last update
+  double resolution_m = 0.05;       // finest level; level k has resolution_m * 2^k
+  int levels = 3;                   // pyramid depth, 1 = a single grid
+  double p_occupied = 0.9;          // probability an end point's cell is occupied (Hector 0.9)
+  double p_free = 0.4;              // probability a traversed cell is occupied (Hector 0.4)
+  double update_distance_m = 0.2;   // update the map when the pose moved this far ...
+  double update_angle_rad = 0.1;    // ... or turned this much since the last update
   int64_t max_bytes = 512LL << 20;  // beyond this, tiles farthest from the pose are dropped
 
   template <class V>
@@ -38,9 +39,9 @@ struct MatcherConfig {
   // Points closer than this to the previously kept point along the scan are not matched (0 = all).
   // Fewer points: proportionally faster matching, slightly noisier poses; map updates use all.
   double min_point_spacing_m = 0.02;
-  int min_valid_points = 20;   // fewer valid readings: the pose is predicted, not measured
-  double min_range_m = 0.1;    // readings outside [min_range_m, max_range_m] are ignored
-  double max_range_m = 40.0;   // (and outside the scan's own range_min/range_max)
+  int min_valid_points = 20;  // fewer valid readings: the pose is predicted, not measured
+  double min_range_m = 0.1;   // readings outside [min_range_m, max_range_m] are ignored
+  double max_range_m = 40.0;  // (and outside the scan's own range_min/range_max)
   // Weak prior pulling towards the motion prediction: keeps directions the geometry does not
   // constrain (a featureless corridor's axis) at the predicted value instead of drifting.
   double prior_sigma_xy_m = 0.5;
@@ -127,5 +128,24 @@ struct FrontendConfig {
     v("deskew", deskew);
   }
 };
+
+// The values a frontend cannot run with, named; nullopt when the config is usable.
+inline std::optional<std::string> config_problem(const FrontendConfig& c) {
+  if (!(c.map.resolution_m >= 0.005)) return "map.resolution_m must be at least 0.005";
+  if (c.map.levels < 1 || c.map.levels > 8) return "map.levels must be 1 to 8";
+  if (!(c.map.p_occupied > 0.5 && c.map.p_occupied < 1.0))
+    return "map.p_occupied must be in (0.5, 1)";
+  if (!(c.map.p_free > 0.0 && c.map.p_free < 0.5)) return "map.p_free must be in (0, 0.5)";
+  if (c.map.max_bytes <= 0) return "map.max_bytes must be positive";
+  if (c.matcher.iterations_coarse < 1 || c.matcher.iterations_fine < 1)
+    return "matcher.iterations_coarse and iterations_fine must be at least 1";
+  if (!(c.matcher.prior_sigma_xy_m > 0.0 && c.matcher.prior_sigma_theta_rad > 0.0))
+    return "matcher.prior_sigma_xy_m and prior_sigma_theta_rad must be positive";
+  if (!(c.matcher.max_range_m > c.matcher.min_range_m))
+    return "matcher.max_range_m must exceed min_range_m";
+  if (!(c.matcher.search_linear_window_m > 0.0 && c.matcher.search_angular_window_rad > 0.0))
+    return "matcher.search_linear_window_m and search_angular_window_rad must be positive";
+  return std::nullopt;
+}
 
 }  // namespace traverse::frontend

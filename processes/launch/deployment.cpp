@@ -135,4 +135,14 @@ long recv_buf_size_of(const std::string& url) {
   }
 }
 
+std::string expand_out_dir(const std::string& arg, const std::string& out_dir) {
+  static const std::string kToken = "{out}";
+  std::string r = arg;
+  for (auto pos = r.find(kToken); pos != std::string::npos; pos = r.find(kToken, pos)) {
+    r.replace(pos, kToken.size(), out_dir);
+    pos += out_dir.size();
+  }
+  return r;
+}
+
 }  // namespace traverse::launch

@@ -4,7 +4,8 @@
 //     - name: frontend                  # instance name; status on STATUS_FRONTEND
 //       program: traverse-frontend      # looked up in the build's bin/ (or a path with '/')
 //       config: configs/frontend.yaml   # optional; relative paths are from the repository root
-//       args: [--some-flag, value]      # optional extra arguments
+//       args: [--out, "{out}/frontend"]  # optional extra arguments; {out} = the run's folder
+//       stop_timeout_s: 60              # optional: time it may take to stop (e.g. exports)
 //
 // and the launcher gives each one its config, --name and the one LCM URL of the run. Also here:
 // choosing a private LCM port that no other run on this machine holds at the same time.
@@ -21,6 +22,7 @@ struct StageSpec {
   std::string program;
   std::string config;
   std::vector<std::string> args;
+  double stop_timeout_s = 0.0;  // [s] from SIGINT to SIGTERM; 0: the launcher's --stop-timeout
 
   template <class V>
   void visit(V& v) {
@@ -28,6 +30,7 @@ struct StageSpec {
     v("program", program);
     v("config", config);
     v("args", args);
+    v("stop_timeout_s", stop_timeout_s);
   }
 };
 
@@ -70,6 +73,9 @@ class PortLease {
 // Reserves a port in [first_port, last_port], starting at a random place. Locks live in
 // `lock_dir`. nullopt when every port is taken.
 std::optional<PortLease> reserve_port(const std::string& lock_dir, int first_port, int last_port);
+
+// `arg` with every "{out}" replaced by `out_dir`.
+std::string expand_out_dir(const std::string& arg, const std::string& out_dir);
 
 // udpm URL of a run: loopback-only multicast (ttl=0) on `port` with a large receive buffer.
 std::string private_url(int port, int recv_buf_bytes);

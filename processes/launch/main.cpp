@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -187,6 +188,7 @@ int main(int argc, char** argv) {
       return traverse::kConfigErrorExitCode;
     }
   }
+  double stop_timeout_s = o.stop_timeout_s;  // the longest any stage may need
   for (const auto& s : *stages) {
     Planned p{s.name, {find_program(s.program, o.bin_dir)}};
     if (p.argv[0].empty()) {
@@ -205,7 +207,10 @@ int main(int argc, char** argv) {
       p.argv.insert(p.argv.end(), {"--config", fs::absolute(cfg).string()});
     }
     p.argv.insert(p.argv.end(), {"--name", s.name});
-    p.argv.insert(p.argv.end(), s.args.begin(), s.args.end());
+    for (const auto& a : s.args) {
+      p.argv.push_back(traverse::launch::expand_out_dir(a, fs::absolute(o.out).string()));
+    }
+    stop_timeout_s = std::max(stop_timeout_s, s.stop_timeout_s);
     planned.push_back(std::move(p));
   }
 
@@ -317,7 +322,7 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   }
-  sup.stop(stage_names, o.stop_timeout_s);
+  sup.stop(stage_names, stop_timeout_s);
   sup.stop({"monitor"}, o.stop_timeout_s);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // last messages reach the logger
   sup.stop({"logger"}, o.stop_timeout_s);

@@ -30,7 +30,8 @@ struct Run {
 
 int main(int argc, char** argv) {
   CLI::App app("traverse-mapper-bench: Mapper points per second vs OcTree::insertPointCloud");
-  std::string world_file = "configs/worlds/office.yaml", route_file = "configs/routes/office-x2.yaml";
+  std::string world_file = "configs/worlds/office.yaml",
+              route_file = "configs/routes/office-x2.yaml";
   std::string rig_file = "configs/rig.yaml";
   double duration_s = 60, begin_s = 10, baseline_s = 2;
   app.add_option("--world", world_file);
@@ -61,8 +62,8 @@ int main(int argc, char** argv) {
       gt.push_back(e->ground_truth.T_world_base);
     } else if (e->kind == ts::SimEvent::Kind::kScanProfile) {
       const ts::ScanData& s = e->scan;
-      profiles.push_back({s.utime_first, s.utime_last, s.angle_first, s.angle_step, s.ranges,
-                          s.intensities});
+      profiles.push_back(
+          {s.utime_first, s.utime_last, s.angle_first, s.angle_step, s.ranges, s.intensities});
     }
   }
   std::fprintf(stderr, "simulated %.0f s: %zu profiles, %zu true poses in %.1f s\n", duration_s,
@@ -116,7 +117,8 @@ int main(int argc, char** argv) {
       auto it = std::lower_bound(gt_t.begin(), gt_t.end(), t_mid);
       const traverse::Pose2& T = gt[static_cast<std::size_t>(it - gt_t.begin())];
       const Eigen::Vector2d o = T * Eigen::Vector2d(T_base_laser.translation().head<2>());
-      tree.insertPointCloud(clouds[i], octomap::point3d(o.x(), o.y(), T_base_laser.translation().z()));
+      tree.insertPointCloud(clouds[i],
+                            octomap::point3d(o.x(), o.y(), T_base_laser.translation().z()));
       runs[r].octomap_points += static_cast<int64_t>(clouds[i].size());
     }
     runs[r].octomap_s = seconds_since(t0);
@@ -126,7 +128,8 @@ int main(int argc, char** argv) {
     runs[r].moved_profiles = static_cast<int64_t>(mapper.apply_moves());
     runs[r].move_s = seconds_since(t0);
   }
-  const double span_s = 1e-6 * static_cast<double>(profiles.back().utime_last - profiles.front().utime_first);
+  const double span_s =
+      1e-6 * static_cast<double>(profiles.back().utime_last - profiles.front().utime_first);
   double pps[2], octo[2], ratio[2];
   for (int r = 0; r < 2; ++r) {
     pps[r] = runs[r].points / runs[r].mapper_s;

@@ -7,6 +7,12 @@
 
 namespace traverse::mapper {
 
+void transform_cloud(std::vector<CloudPoint>& cloud, const Pose2& T_world_map) {
+  const Eigen::Matrix2f R = T_world_map.rotation().cast<float>();
+  const Eigen::Vector2f t = T_world_map.translation().cast<float>();
+  for (CloudPoint& p : cloud) p.p_world.head<2>() = R * p.p_world.head<2>() + t;
+}
+
 Stats describe(std::vector<double> v, double bin) {
   Stats s;
   s.n = static_cast<int>(v.size());
@@ -86,8 +92,7 @@ CloudEvalResult evaluate_cloud(const std::vector<CloudPoint>& cloud, const sim::
   stride = std::max<std::size_t>(stride, 1);
   dist.reserve(cloud.size() / stride + 1);
   for (std::size_t i = 0; i < cloud.size(); i += stride) {
-    dist.push_back(
-        world.distance_to_surface(cloud[i].p_world.cast<double>(), config.max_search_m));
+    dist.push_back(world.distance_to_surface(cloud[i].p_world.cast<double>(), config.max_search_m));
   }
   out.surface = describe(std::move(dist), config.histogram_bin_m);
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mapper.hpp"
+#include "se2.hpp"
 #include "world.hpp"
 #include "world_spec.hpp"
 
@@ -23,8 +24,8 @@ namespace traverse::mapper {
 // An end wall of a corridor: the plane x = at (axis "x") or y = at (axis "y"), seen through a box.
 struct WallProbe {
   std::string axis = "x";
-  double at = 0.0;                       // [m] true position of the plane
-  std::vector<double> across = {0, 1};   // [m] range of the other horizontal coordinate
+  double at = 0.0;                      // [m] true position of the plane
+  std::vector<double> across = {0, 1};  // [m] range of the other horizontal coordinate
   template <class V>
   void visit(V& v) {
     v("axis", axis);
@@ -45,13 +46,13 @@ struct CorridorSpec {
 };
 
 struct CloudEvalConfig {
-  double max_search_m = 0.5;      // [m] distances are capped here (gross outliers)
+  double max_search_m = 0.5;        // [m] distances are capped here (gross outliers)
   double histogram_bin_m = 0.0005;  // [m] bin of the distance histogram (mode)
-  double pillar_band_m = 0.05;    // [m] points within this of the true pillar surface are used
-  double pillar_trim_m = 0.015;   // [m] points farther from the fitted circle are dropped
+  double pillar_band_m = 0.05;      // [m] points within this of the true pillar surface are used
+  double pillar_trim_m = 0.015;     // [m] points farther from the fitted circle are dropped
   int pillar_min_points = 50;
   double z_min_m = 0.3, z_max_m = 2.5;  // [m] height band of pillar and wall points
-  double wall_band_m = 0.1;       // [m] points within this of an end wall's true plane
+  double wall_band_m = 0.1;             // [m] points within this of an end wall's true plane
   std::vector<CorridorSpec> corridors;
   template <class V>
   void visit(V& v) {
@@ -87,9 +88,12 @@ struct CorridorResult {
 struct CloudEvalResult {
   Stats surface;  // point-to-surface distances [m]
   std::vector<PillarResult> pillars;
-  Stats pillar;   // over pillars with a fit [m]
+  Stats pillar;  // over pillars with a fit [m]
   std::vector<CorridorResult> corridors;
 };
+
+// Moves every point by a planar transform T_world_map (the cloud was built in the map frame).
+void transform_cloud(std::vector<CloudPoint>& cloud, const Pose2& T_world_map);
 
 // Statistics of a sample (mode from a histogram with `bin` wide bins, if bin > 0).
 Stats describe(std::vector<double> values, double bin);

@@ -5,11 +5,14 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <map>
 #include <sstream>
 
 #include "cloud_eval.hpp"
 #include "config.hpp"
+#include "lcm_log.hpp"
 #include "ply.hpp"
+#include "traverse/pose2d_t.hpp"
 
 namespace {
 
@@ -21,16 +24,54 @@ std::string num(double v) {
 
 std::string opt(const std::optional<double>& v) { return v ? num(*v) : "null"; }
 
+// First-pose alignment as the trajectory evaluator does it (seed 000: the runs were tied to the
+// reference only through the starting pose): T_world_map = T_ref(t0) T_est(t0)^-1 at the first
+// estimate pose t0, the reference interpolated there.
+std::optional<traverse::Pose2> first_pose_alignment(const std::string& log,
+                                                    const std::string& estimate,
+                                                    const std::string& reference) {
+  traverse::LogReader reader(log);
+  std::optional<traverse::pose2d_t> est;
+  std::map<int64_t, traverse::Pose2> ref;
+  while (auto e = reader.next()) {
+    if (e->channel != estimate && e->channel != reference) continue;
+    traverse::pose2d_t m;
+    if (m.decode(e->data.data(), 0, static_cast<int>(e->data.size())) !=
+        static_cast<int>(e->data.size())) {
+      continue;
+    }
+    if (e->channel == estimate && (!est || m.utime < est->utime)) est = m;
+    if (e->channel == reference) ref[m.utime] = traverse::Pose2(m.x, m.y, m.theta);
+  }
+  if (!est) return std::nullopt;
+  auto hi = ref.lower_bound(est->utime);
+  if (hi == ref.end() || (hi == ref.begin() && hi->first != est->utime)) return std::nullopt;
+  traverse::Pose2 T_world_base = hi->second;
+  if (hi->first != est->utime) {
+    auto lo = std::prev(hi);
+    const double s =
+        static_cast<double>(est->utime - lo->first) / static_cast<double>(hi->first - lo->first);
+    T_world_base = traverse::interpolate(lo->second, hi->second, s);
+  }
+  return T_world_base * traverse::Pose2(est->x, est->y, est->theta).inverse();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("traverse-cloud-eval: a mapper cloud against the simulator's true surfaces, "
-               "pillars and corridors; JSON last");
+  CLI::App app(
+      "traverse-cloud-eval: a mapper cloud against the simulator's true surfaces, "
+      "pillars and corridors; JSON last");
   std::string world_file, cloud_file, config_file;
   std::size_t max_points = 5'000'000;
   app.add_option("--world", world_file, "world YAML (configs/worlds/*.yaml)")->required();
   app.add_option("--cloud", cloud_file, "PLY written by traverse-mapper")->required();
   app.add_option("--config", config_file, "evaluation settings (configs/cloud-eval-office.yaml)");
+  std::string log, estimate = "POSE_DENSE", reference = "POSE_GROUND_TRUTH";
+  app.add_option("--log", log,
+                 "run log: align the cloud's map frame to the world by the first poses");
+  app.add_option("--estimate", estimate, "trajectory channel the cloud was built with");
+  app.add_option("--reference", reference, "true trajectory channel");
   app.add_option("--max-points", max_points,
                  "surface distances on at most this many points (evenly spread)");
   CLI11_PARSE(app, argc, argv);
@@ -50,8 +91,27 @@ int main(int argc, char** argv) {
     spdlog::error("{}", error);
     return 1;
   }
+  traverse::Pose2 T_world_map;
+  if (!log.empty()) {
+    std::optional<traverse::Pose2> align;
+    try {
+      align = first_pose_alignment(log, estimate, reference);
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+      return 1;
+    }
+    if (!align) {
+      spdlog::error("{}: no {} pose inside the {} poses to align with", log, estimate, reference);
+      return 1;
+    }
+    T_world_map = *align;
+    traverse::mapper::transform_cloud(*cloud, T_world_map);
+  }
+  std::printf("alignment T_world_map: x %.4f m, y %.4f m, theta %.4f rad\n", T_world_map.x(),
+              T_world_map.y(), T_world_map.theta());
   const traverse::sim::World world(spec);
-  const std::size_t stride = std::max<std::size_t>(1, cloud->size() / std::max<std::size_t>(1, max_points));
+  const std::size_t stride =
+      std::max<std::size_t>(1, cloud->size() / std::max<std::size_t>(1, max_points));
   const auto r = traverse::mapper::evaluate_cloud(*cloud, world, spec, config, stride);
 
   std::printf("cloud: %zu points, %d evaluated against the true surfaces\n", cloud->size(),
@@ -74,19 +134,23 @@ int main(int argc, char** argv) {
                 opt(c.length_m).c_str(), c.true_length_m);
     corridors << (corridors.tellp() > 0 ? ", " : "") << "{\"name\": \"" << c.name
               << "\", \"length_m\": " << opt(c.length_m)
-              << ", \"true_length_m\": " << num(c.true_length_m) << ", \"error_m\": "
-              << (c.length_m ? num(*c.length_m - c.true_length_m) : "null") << "}";
+              << ", \"true_length_m\": " << num(c.true_length_m)
+              << ", \"error_m\": " << (c.length_m ? num(*c.length_m - c.true_length_m) : "null")
+              << "}";
   }
   const bool fitted = r.pillar.n > 0;
   std::printf(
       "{\"cloud_points\": %zu, \"cloud_points_evaluated\": %d, \"cloud_mode_m\": %s, "
       "\"cloud_mean_m\": %s, \"cloud_rmse_m\": %s, \"cloud_p95_m\": %s, \"pillar_n\": %d, "
       "\"pillar_mean_m\": %s, \"pillar_sd_m\": %s, \"pillar_rmse_m\": %s, \"pillar_min_m\": %s, "
-      "\"pillar_max_m\": %s, \"pillars\": [%s], \"corridors\": [%s]}\n",
+      "\"pillar_max_m\": %s, \"cloud_align_x_m\": %.6f, \"cloud_align_y_m\": %.6f, "
+      "\"cloud_align_theta_rad\": %.6f, "
+      "\"pillars\": [%s], \"corridors\": [%s]}\n",
       cloud->size(), r.surface.n, num(r.surface.mode).c_str(), num(r.surface.mean).c_str(),
       num(r.surface.rmse).c_str(), num(r.surface.p95).c_str(), r.pillar.n,
       fitted ? num(r.pillar.mean).c_str() : "null", fitted ? num(r.pillar.sd).c_str() : "null",
       fitted ? num(r.pillar.rmse).c_str() : "null", fitted ? num(r.pillar.min).c_str() : "null",
-      fitted ? num(r.pillar.max).c_str() : "null", pillars.str().c_str(), corridors.str().c_str());
+      fitted ? num(r.pillar.max).c_str() : "null", T_world_map.x(), T_world_map.y(),
+      T_world_map.theta(), pillars.str().c_str(), corridors.str().c_str());
   return 0;
 }

@@ -20,7 +20,10 @@ int main(int argc, char** argv) {
                          "3D mapper: tilted profiles -> OctoMap and point cloud that follow loop "
                          "closures; exports on SIGUSR1 and at shutdown");
   traverse::mapper::MapperConfig config;
+  std::string out_dir;
+  proc.cli().add_option("--out", out_dir, "export folder (overrides output_dir of the config)");
   if (auto rc = proc.start(argc, argv, config)) return *rc;
+  if (!out_dir.empty()) config.output_dir = out_dir;
   traverse::sim::RigConfig rig;
   try {
     traverse::load_config(config.rig_file, rig);

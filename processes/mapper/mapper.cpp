@@ -32,7 +32,8 @@ Mapper::Stored Mapper::compress(const Profile& p) {
     const double r = p.ranges[i];
     if (!std::isfinite(r) || r < config_.range_min_m || r > config_.range_max_m || r <= 0) continue;
     const double a = p.angle_first + static_cast<double>(i) * p.angle_step;
-    const Eigen::Vector3d p_base = T_base_laser_ * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0);
+    const Eigen::Vector3d p_base =
+        T_base_laser_ * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0);
     if (in_footprint(config_.footprint, p_base)) {
       ++points_filtered_;
       continue;
@@ -73,11 +74,12 @@ bool Mapper::place(const Stored& s, std::vector<Eigen::Vector3f>& pts,
       j = 1;
     }
     while (j + 1 < seg->utimes.size() && seg->utimes[j] < t) ++j;
-    const Pose2 T = interpolate_linear(seg->utimes[j - 1], seg->T_world_base[j - 1],
-                                       seg->utimes[j], seg->T_world_base[j], t);
+    const Pose2 T = interpolate_linear(seg->utimes[j - 1], seg->T_world_base[j - 1], seg->utimes[j],
+                                       seg->T_world_base[j], t);
     const double r = s.range_q[i] * range_quantum_m_;
     const double a = s.angle_first + static_cast<double>(i) * s.angle_step;
-    const Eigen::Vector3d p_base = R_bl * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0) + t_bl;
+    const Eigen::Vector3d p_base =
+        R_bl * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0) + t_bl;
     const double c = std::cos(T.theta()), sn = std::sin(T.theta());
     pts.emplace_back(static_cast<float>(T.x() + c * p_base.x() - sn * p_base.y()),
                      static_cast<float>(T.y() + sn * p_base.x() + c * p_base.y()),
@@ -126,9 +128,8 @@ void Mapper::try_pending() {
       tree_->updateNode(k, true, true);
     }
     points_ += s.n_points;
-    auto pos = std::upper_bound(
-        stored_.begin(), stored_.end(), s.utime_first,
-        [](int64_t t, const Stored& x) { return t < x.utime_first; });
+    auto pos = std::upper_bound(stored_.begin(), stored_.end(), s.utime_first,
+                                [](int64_t t, const Stored& x) { return t < x.utime_first; });
     stored_.insert(pos, std::move(s));
   }
 }
@@ -194,8 +195,7 @@ void Mapper::for_each_point(const std::function<void(const CloudPoint&)>& f) con
   std::vector<int> beams;
   for (const Stored& s : stored_) {
     if (!place(s, pts, beams)) continue;
-    const double dt =
-        static_cast<double>(s.utime_last - s.utime_first) / (s.range_q.size() - 1);
+    const double dt = static_cast<double>(s.utime_last - s.utime_first) / (s.range_q.size() - 1);
     for (std::size_t i = 0; i < pts.size(); ++i) {
       f({pts[i], s.intensity[beams[i]], s.utime_first + std::llround(beams[i] * dt), s.key_id});
     }

@@ -56,8 +56,8 @@ struct MapperConfig {
   Footprint footprint;
   std::string rig_file = "configs/rig.yaml";  // laser_profile extrinsic T_base_laser
   std::string output_dir = "out/mapper";      // exports: cloud.ply, map.bt, map.ot
-  std::string pose_channel;    // "": DENSE_SEGMENT from the densifier; else pose2d_t stream
-  int poses_per_segment = 40;  // segment length when reading a pose2d_t stream
+  std::string pose_channel;     // "": DENSE_SEGMENT from the densifier; else pose2d_t stream
+  int poses_per_segment = 40;   // segment length when reading a pose2d_t stream
   double max_pending_s = 30.0;  // [s] profiles waiting longer for poses are dropped
   template <class V>
   void visit(V& v) {
@@ -124,7 +124,7 @@ class Mapper {
   struct Stored {
     int64_t utime_first = 0, utime_last = 0;
     float angle_first = 0, angle_step = 0;
-    std::vector<uint16_t> range_q;    // quantised range, 0 = no point
+    std::vector<uint16_t> range_q;  // quantised range, 0 = no point
     std::vector<uint8_t> intensity;
     int64_t key_id = 0;
     int32_t n_points = 0;

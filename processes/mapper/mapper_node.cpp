@@ -7,8 +7,8 @@
 
 namespace traverse::mapper {
 
-MapperNode::MapperNode(Bus& bus, const MapperConfig& config,
-                       const Eigen::Isometry3d& T_base_laser, CounterSink counters)
+MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
+                       CounterSink counters)
     : config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
   bus.subscribe<planar_scan_t>(channels::kScanProfile,
                                [this](const planar_scan_t& m) { on_profile(m); });
@@ -42,7 +42,8 @@ void MapperNode::on_segment(const dense_segment_t& msg) {
   TrajectorySegment s;
   s.key_id_first = msg.key_id_first;
   s.utimes = msg.pose_utime;
-  for (int i = 0; i < msg.n_poses; ++i) s.T_world_base.emplace_back(msg.x[i], msg.y[i], msg.theta[i]);
+  for (int i = 0; i < msg.n_poses; ++i)
+    s.T_world_base.emplace_back(msg.x[i], msg.y[i], msg.theta[i]);
   if (!mapper_.set_segment(s)) ++rejected_;
 }
 

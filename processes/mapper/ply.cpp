@@ -51,10 +51,9 @@ bool write_ply(const std::string& path, int64_t count,
 }
 
 bool write_ply(const std::string& path, const Mapper& mapper) {
-  return write_ply(path, mapper.placed_points(),
-                   [&mapper](const std::function<void(const CloudPoint&)>& f) {
-                     mapper.for_each_point(f);
-                   });
+  return write_ply(
+      path, mapper.placed_points(),
+      [&mapper](const std::function<void(const CloudPoint&)>& f) { mapper.for_each_point(f); });
 }
 
 std::optional<std::vector<CloudPoint>> read_ply(const std::string& path, std::string* error) {

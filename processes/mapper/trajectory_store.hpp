@@ -13,8 +13,8 @@
 namespace traverse::mapper {
 
 struct TrajectorySegment {
-  int64_t key_id_first = 0;        // key pose that starts the segment
-  std::vector<int64_t> utimes;     // [us] increasing, at least two
+  int64_t key_id_first = 0;         // key pose that starts the segment
+  std::vector<int64_t> utimes;      // [us] increasing, at least two
   std::vector<Pose2> T_world_base;  // one per time
   int64_t utime_first() const { return utimes.front(); }
   int64_t utime_last() const { return utimes.back(); }

@@ -96,6 +96,8 @@ TEST_F(BackendNodeTest, MessagesStayIncrementalAsTheGraphGrows) {
 TEST_F(BackendNodeTest, LoopClosuresRepublishMovedPosesInBoundedParts) {
   BackendNodeConfig config;
   config.max_poses_per_message = 10;
+  config.backend.frontend_sigma_xy_m = 0.015;  // this drifting frontend's real precision per link
+  config.backend.frontend_sigma_theta_rad = 0.005;
   run(config, 18.0);
   ASSERT_GT(counters_.at("loop_closures"), 0.0);
   int closures = 0, multipart = 0;

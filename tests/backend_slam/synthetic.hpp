@@ -24,8 +24,8 @@ inline PlanarScan sweep(const synthetic::World& world, const Pose2& T_world_base
   spec.utime_first = utime_first;
   spec.range_max = range_max_m;
   spec.noise_sigma_m = noise_m;
-  const frontend::Scan s =
-      synthetic::make_sweep(world, [&](int64_t) { return T_world_base; }, Pose2(), spec, &rng);
+  const frontend::Scan s = synthetic::make_sweep(
+      world, [&](int64_t) { return T_world_base; }, Pose2(), spec, &rng);
   PlanarScan out;
   out.utime_first = s.utime_first;
   out.utime_last = s.utime_last;
@@ -43,8 +43,9 @@ inline std::vector<Eigen::Vector2f> key_points(const synthetic::World& world,
                                                std::mt19937& rng) {
   ScanStoreConfig config;
   config.max_range_m = range_max_m;
-  return reduce_scan(sweep(world, T_world_base, range_max_m, rng), Pose2(),
-                     [](int64_t) { return Pose2(); }, config);
+  return reduce_scan(
+      sweep(world, T_world_base, range_max_m, rng), Pose2(), [](int64_t) { return Pose2(); },
+      config);
 }
 
 inline std::vector<Eigen::Vector2d> to_double(const std::vector<Eigen::Vector2f>& p) {
@@ -68,8 +69,8 @@ inline synthetic::World irregular_corridor() {
     w.push_back({{n1, -1.2}, {b, -1.2}});
   }
   w.push_back({{-15.0, 1.2}, {15.0, 1.2}});
-  const double boxes[][2] = {{-12.0, 0.6}, {-7.9, 0.75}, {-2.2, 0.5}, {1.6, 0.8}, {5.1, 0.55},
-                             {8.4, 0.7},   {11.7, 0.6}};
+  const double boxes[][2] = {{-12.0, 0.6}, {-7.9, 0.75}, {-2.2, 0.5}, {1.6, 0.8},
+                             {5.1, 0.55},  {8.4, 0.7},   {11.7, 0.6}};
   for (const auto& b : boxes) {
     const double x = b[0], s = b[1];
     w.push_back({{x, 1.2}, {x, 1.2 - s * 0.6}});
@@ -102,9 +103,9 @@ namespace traverse::backend::test {
 // room, one sweep of 1440 beams every 100 ms taken while moving, and a drifting frontend: its
 // odometry is 3 % long and turns 0.01 rad per metre too much.
 struct Drive {
-  std::vector<int64_t> utimes;   // [us] pose times (the last point of each sweep)
-  std::vector<Pose2> truth;      // T_world_base at those times
-  std::vector<Pose2> input;      // the drifting frontend's T_map_base
+  std::vector<int64_t> utimes;  // [us] pose times (the last point of each sweep)
+  std::vector<Pose2> truth;     // T_world_base at those times
+  std::vector<Pose2> input;     // the drifting frontend's T_map_base
   std::vector<PlanarScan> scans;
 };
 
@@ -129,7 +130,8 @@ inline Drive drive_ellipse(double duration_s, unsigned seed = 5) {
   const auto truth_at = [](int64_t t) { return ellipse_pose(1e-6 * static_cast<double>(t)); };
   for (int64_t t0 = 0; 1e-6 * static_cast<double>(t0) < duration_s; t0 += period_us) {
     spec.utime_first = t0;
-    const frontend::Scan s = synthetic::make_sweep(synthetic::room(), truth_at, Pose2(), spec, &rng);
+    const frontend::Scan s =
+        synthetic::make_sweep(synthetic::room(), truth_at, Pose2(), spec, &rng);
     PlanarScan scan{s.utime_first, s.utime_last, s.angle_first, s.angle_step,
                     s.range_min,   s.range_max,  s.ranges};
     const int64_t t = s.utime_last;

@@ -40,8 +40,7 @@ TEST_P(BothModes, ExactTrajectoryIsUnchanged) {
   for (std::size_t i = 0; i < out.size(); ++i) {
     EXPECT_NEAR((out[i].T_world_base.translation() - dense[i].T_world_base.translation()).norm(),
                 0.0, 1e-9);
-    EXPECT_NEAR(wrap_angle(out[i].T_world_base.theta() - dense[i].T_world_base.theta()), 0.0,
-                1e-9);
+    EXPECT_NEAR(wrap_angle(out[i].T_world_base.theta() - dense[i].T_world_base.theta()), 0.0, 1e-9);
     EXPECT_EQ(out[i].utime, dense[i].utime);
   }
 }
@@ -54,7 +53,8 @@ TEST_P(BothModes, MeetsBothKeyPosesAndRemovesDrift) {
   for (int i = 0; i <= 20; ++i) {
     const double t = i * kDt * 1e-6;
     truth.emplace_back(0.25 * t, 0.01 * t, 0.02 * t);
-    dense.push_back({kT0 + i * kDt, Pose2(0.2525 * t + 0.003, 0.012 * t - 0.002, 0.02 * t + 0.001)});
+    dense.push_back(
+        {kT0 + i * kDt, Pose2(0.2525 * t + 0.003, 0.012 * t - 0.002, 0.02 * t + 0.001)});
   }
   auto out = correct_segment(dense, truth.front(), truth.back(), GetParam(), 0.5);
   EXPECT_NEAR((out.front().T_world_base.translation() - truth.front().translation()).norm(), 0,
@@ -81,8 +81,9 @@ TEST(Densifier, StandingStillJitterIsMagnifiedByPaperModeOnly) {
   std::vector<Pose2> truth;
   for (int i = 0; i <= 20; ++i) {
     truth.push_back(still);
-    dense.push_back({kT0 + i * kDt, Pose2(still.x() + noise(rng, 1e-3), still.y() + noise(rng, 1e-3),
-                                          still.theta() + noise(rng, 2e-4))});
+    dense.push_back(
+        {kT0 + i * kDt, Pose2(still.x() + noise(rng, 1e-3), still.y() + noise(rng, 1e-3),
+                              still.theta() + noise(rng, 2e-4))});
   }
   // The two end poses of the frontend happen to lie 0.2 mm apart; the optimiser's key poses 4 mm.
   dense.front().T_world_base = Pose2(3.0, 2.0, 0.4);
@@ -92,7 +93,7 @@ TEST(Densifier, StandingStillJitterIsMagnifiedByPaperModeOnly) {
   auto rigid = correct_segment(dense, K_a, K_b, Mode::kRigid, 0.5);
   const double jitter = max_position_error(dense, truth);
   EXPECT_LT(jitter, 1.5e-3);
-  EXPECT_GT(max_position_error(paper, truth), 0.01);            // centimetres (x20 scale)
+  EXPECT_GT(max_position_error(paper, truth), 0.01);             // centimetres (x20 scale)
   EXPECT_LT(max_position_error(rigid, truth), jitter + 4.1e-3);  // jitter plus the key's offset
 }
 

@@ -40,7 +40,8 @@ double line_residual(const std::vector<Eigen::Vector2d>& pts) {
   for (const auto& p : pts) mean += p / static_cast<double>(pts.size());
   Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
   for (const auto& p : pts) C += (p - mean) * (p - mean).transpose();
-  const Eigen::Vector2d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvectors().col(0);
+  const Eigen::Vector2d normal =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvectors().col(0);
   double worst = 0.0;
   for (const auto& p : pts) worst = std::max(worst, std::abs(normal.dot(p - mean)));
   return worst;
@@ -67,16 +68,18 @@ TEST(Deskew, RecoversStraightWallFromRotatingSweep) {
     if (!std::isfinite(scan.ranges[i])) continue;
     const double a = scan.angle_first + i * scan.angle_step;
     points.emplace_back(scan.ranges[i] * std::cos(a), scan.ranges[i] * std::sin(a));
-    utimes.push_back(scan.utime_first + std::llround(spec.duration_us * (i / (spec.n_ranges - 1.0))));
+    utimes.push_back(scan.utime_first +
+                     std::llround(spec.duration_us * (i / (spec.n_ranges - 1.0))));
   }
   ASSERT_GT(points.size(), 1500u);
   const double raw = line_residual(points);
-  deskew_points(points, utimes, scan.utime_last,
-                [&](int64_t t) { return yaw.heading_change(scan.utime_last, t); },
-                Eigen::Vector2d::Zero(), true);
+  deskew_points(
+      points, utimes, scan.utime_last,
+      [&](int64_t t) { return yaw.heading_change(scan.utime_last, t); }, Eigen::Vector2d::Zero(),
+      true);
   const double corrected = line_residual(points);
-  EXPECT_GT(raw, 0.1);           // bent by tens of centimetres
-  EXPECT_LT(corrected, 1e-6);    // straight again
+  EXPECT_GT(raw, 0.1);         // bent by tens of centimetres
+  EXPECT_LT(corrected, 1e-6);  // straight again
   // And where the wall is in the base frame at the last point: x = 3 / cos(heading).
   const Pose2 T_end = truth(scan.utime_last);
   for (const auto& p : points) EXPECT_NEAR((T_end * p).x(), 3.0, 1e-6);
@@ -98,10 +101,12 @@ TEST(Deskew, TranslationFromConstantVelocity) {
   for (int i = 0; i < spec.n_ranges; ++i) {
     const double a = scan.angle_first + i * scan.angle_step;
     points.emplace_back(scan.ranges[i] * std::cos(a), scan.ranges[i] * std::sin(a));
-    utimes.push_back(scan.utime_first + std::llround(spec.duration_us * (i / (spec.n_ranges - 1.0))));
+    utimes.push_back(scan.utime_first +
+                     std::llround(spec.duration_us * (i / (spec.n_ranges - 1.0))));
   }
-  deskew_points(points, utimes, scan.utime_last, [](int64_t) { return 0.0; },
-                Eigen::Vector2d(1.0, 0.0), true);
+  deskew_points(
+      points, utimes, scan.utime_last, [](int64_t) { return 0.0; }, Eigen::Vector2d(1.0, 0.0),
+      true);
   for (const auto& p : points) EXPECT_NEAR(p.x(), 3.0 - 0.1, 1e-6);  // float ranges
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "config.hpp"
 #include "synthetic_scans.hpp"
 
 namespace traverse::frontend {
@@ -36,7 +37,9 @@ RoomRun run_room(const FrontendConfig& config, bool with_imu, double turn_rate, 
     const double s = ramp(1e-6 * static_cast<double>(t));
     return Pose2(-2.0 + 0.5 * s, -1.0 + 0.3 * std::sin(s), turn_rate * s);
   };
-  auto yaw_rate = [&](int64_t t) { return turn_rate * std::min(1.0, 2e-6 * static_cast<double>(t)); };
+  auto yaw_rate = [&](int64_t t) {
+    return turn_rate * std::min(1.0, 2e-6 * static_cast<double>(t));
+  };
   Frontend frontend(config);
   std::mt19937 rng(3);
   RoomRun run;
@@ -44,7 +47,8 @@ RoomRun run_room(const FrontendConfig& config, bool with_imu, double turn_rate, 
   const Pose2 T_laser;
   Pose2 T_map_world;
   for (int k = 0; k < scans; ++k) {
-    const Scan scan = synthetic::make_sweep(world, truth, T_laser, small_sweep(k * kPeriodUs), &rng);
+    const Scan scan =
+        synthetic::make_sweep(world, truth, T_laser, small_sweep(k * kPeriodUs), &rng);
     for (; with_imu && imu_t <= scan.utime_last; imu_t += 5000) {
       frontend.add_imu(imu_t, Eigen::Vector3d(0.01, -0.02, yaw_rate(imu_t)));
     }
@@ -96,8 +100,9 @@ class FrontendBadScans : public ::testing::Test {
     }
   }
   Scan good_scan(int k) {
-    return synthetic::make_sweep(world_, [](int64_t) { return Pose2(0.2, 0.1, 0.0); }, Pose2(),
-                                 small_sweep(k * kPeriodUs), &rng_);
+    return synthetic::make_sweep(
+        world_, [](int64_t) { return Pose2(0.2, 0.1, 0.0); }, Pose2(), small_sweep(k * kPeriodUs),
+        &rng_);
   }
   synthetic::World world_ = synthetic::room();
   std::mt19937 rng_{5};
@@ -149,6 +154,14 @@ TEST_F(FrontendBadScans, DropsScansWhoseTimeGoesBackOrIsInconsistent) {
   EXPECT_EQ(frontend_.process(good_scan(4)).status, ScanStatus::kDropped);  // same time again
   EXPECT_EQ(frontend_.counters().scans_dropped_time, 3);
   EXPECT_EQ(frontend_.process(good_scan(5)).status, ScanStatus::kMatched);
+}
+
+TEST(Frontend, ShippedConfigLoadsAndIsUsable) {
+  FrontendConfig config;
+  load_config("configs/frontend.yaml", config);
+  EXPECT_EQ(config_problem(config), std::nullopt);
+  config.map.levels = 0;
+  EXPECT_NE(config_problem(config), std::nullopt);
 }
 
 TEST(Frontend, DropsImuSamplesGoingBack) {

@@ -64,8 +64,10 @@ TEST(OccupancyGrid, BilinearGradientMatchesNumericalDerivative) {
     Eigen::Vector2d grad;
     grid.value(p, &grad);
     const double h = 1e-6;
-    const double gx = (grid.value(p + Eigen::Vector2d(h, 0)) - grid.value(p - Eigen::Vector2d(h, 0))) / (2 * h);
-    const double gy = (grid.value(p + Eigen::Vector2d(0, h)) - grid.value(p - Eigen::Vector2d(0, h))) / (2 * h);
+    const double gx =
+        (grid.value(p + Eigen::Vector2d(h, 0)) - grid.value(p - Eigen::Vector2d(h, 0))) / (2 * h);
+    const double gy =
+        (grid.value(p + Eigen::Vector2d(0, h)) - grid.value(p - Eigen::Vector2d(0, h))) / (2 * h);
     EXPECT_NEAR(grad.x(), gx, 1e-4 * (1.0 + std::abs(gx)));
     EXPECT_NEAR(grad.y(), gy, 1e-4 * (1.0 + std::abs(gy)));
     if (grad.norm() > 1.0) ++informative;
@@ -96,7 +98,7 @@ TEST(OccupancyGrid, EvictsFarthestTilesToStayUnderBudget) {
   const std::size_t budget = grid.memory_bytes() / 2;
   EXPECT_GT(grid.evict_farthest({0, 0}, budget), 0u);
   EXPECT_LE(grid.memory_bytes(), budget);
-  EXPECT_GT(grid.value({1.0, 0}), 0.85);      // near the pose: kept
+  EXPECT_GT(grid.value({1.0, 0}), 0.85);          // near the pose: kept
   EXPECT_DOUBLE_EQ(grid.value({491.0, 0}), 0.5);  // far away: forgotten
 }
 

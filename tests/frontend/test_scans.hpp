@@ -2,7 +2,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <random>
 #include <vector>
 
@@ -15,14 +14,15 @@ namespace traverse::frontend::testing {
 // Gaussian range noise.
 inline std::vector<Eigen::Vector2d> static_scan(const synthetic::World& world,
                                                 const Pose2& T_world_base, int beams = 1440,
-                                                double noise_m = 0.0, unsigned seed = 1) {
+                                                double noise_m = 0.0, unsigned seed = 1,
+                                                double max_range_m = 40.0) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, noise_m > 0 ? noise_m : 1.0);
   std::vector<Eigen::Vector2d> points;
   for (int i = 0; i < beams; ++i) {
     const double a = 2.0 * M_PI * i / beams;
     const Eigen::Vector2d d(std::cos(a + T_world_base.theta()), std::sin(a + T_world_base.theta()));
-    auto r = synthetic::cast_ray(world, T_world_base.translation(), d, 40.0);
+    auto r = synthetic::cast_ray(world, T_world_base.translation(), d, max_range_m);
     if (!r) continue;
     const double range = *r + (noise_m > 0 ? noise(rng) : 0.0);
     points.emplace_back(range * std::cos(a), range * std::sin(a));

@@ -77,11 +77,14 @@ TEST(Mapper, PlacesEveryPointWithThePoseAtItsOwnTime) {
   m.for_each_point([&](const CloudPoint& p) {
     const Pose2 T_wb = truth(p.utime);
     Eigen::Isometry3d T_world_base = Eigen::Isometry3d::Identity();
-    T_world_base.linear() = Eigen::AngleAxisd(T_wb.theta(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T_world_base.linear() =
+        Eigen::AngleAxisd(T_wb.theta(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
     T_world_base.translation() = Eigen::Vector3d(T_wb.x(), T_wb.y(), 0);
-    const int beam = static_cast<int>(std::lround((p.utime - (kT0 + 20'000)) * (kBeams - 1) / 33'000.0));
+    const int beam =
+        static_cast<int>(std::lround((p.utime - (kT0 + 20'000)) * (kBeams - 1) / 33'000.0));
     const double a = -std::numbers::pi + beam * 2 * std::numbers::pi / kBeams;
-    const Eigen::Vector3d expected = T_world_base * T_bl * Eigen::Vector3d(2.5 * std::cos(a), 2.5 * std::sin(a), 0);
+    const Eigen::Vector3d expected =
+        T_world_base * T_bl * Eigen::Vector3d(2.5 * std::cos(a), 2.5 * std::sin(a), 0);
     // Linear interpolation between poses 10 ms apart on a curve, float output: within 0.2 mm.
     EXPECT_LT((p.p_world.cast<double>() - expected).norm(), 2e-4);
     EXPECT_EQ(p.key_id, 0);
