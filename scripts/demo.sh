@@ -11,4 +11,4 @@ if [[ $# -gt 0 && $1 != -* ]]; then
   route="$1"
   shift
 fi
-exec "$ROOT/scripts/eval-route.sh" "$route" --stages "${TRAVERSE_DEMO_STAGES:-frontend}" "$@"
+exec "$ROOT/scripts/eval-route.sh" "$route" --stages "${TRAVERSE_DEMO_STAGES:-all}" "$@"

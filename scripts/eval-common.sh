@@ -34,7 +34,6 @@ estimate_channel() {
     frontend) echo POSE_FRONTEND ;;
     backend) echo POSE_BACKEND ;;
     densifier | mapper | all) echo POSE_DENSE ;;
-    backend) echo POSE_BACKEND ;;
     *) die "stage '$last' publishes no trajectory this script knows (add it to estimate_channel)" ;;
   esac
 }
