@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scan_message.hpp"
 #include "traverse/key_poses_t.hpp"
 
 namespace traverse::backend {
@@ -32,17 +33,7 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
 }
 
-void BackendNode::on_scan(const planar_scan_t& msg) {
-  PlanarScan scan;
-  scan.utime_first = msg.utime_first;
-  scan.utime_last = msg.utime_last;
-  scan.angle_first = msg.angle_first;
-  scan.angle_step = msg.angle_step;
-  scan.range_min = msg.range_min;
-  scan.range_max = msg.range_max;
-  scan.ranges = msg.ranges;
-  backend_.add_scan(std::move(scan));
-}
+void BackendNode::on_scan(const planar_scan_t& msg) { backend_.add_scan(to_planar_scan(msg)); }
 
 void BackendNode::on_pose(const pose2d_t& msg) {
   if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;

@@ -15,21 +15,12 @@
 #include <functional>
 #include <vector>
 
+#include "planar_scan.hpp"
 #include "se2.hpp"
 
 namespace traverse::backend {
 
-// One sweep of the planar scanner, as published (beam i at utime_first + i * (utime_last -
-// utime_first) / (n - 1), along angle_first + i * angle_step in the laser frame).
-struct PlanarScan {
-  int64_t utime_first = 0;    // [us]
-  int64_t utime_last = 0;     // [us]
-  double angle_first = 0.0;   // [rad] laser frame
-  double angle_step = 0.0;    // [rad]
-  double range_min = 0.0;     // [m]
-  double range_max = 0.0;     // [m]
-  std::vector<float> ranges;  // [m]; NaN, 0 or outside [range_min, range_max]: no return
-};
+using PlanarScan = ::traverse::PlanarScan;
 
 struct ScanStoreConfig {
   double point_spacing_m = 0.05;  // minimum distance between consecutive kept points [m]

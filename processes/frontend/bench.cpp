@@ -16,6 +16,7 @@
 #include "config.hpp"
 #include "frontend.hpp"
 #include "lcm_log.hpp"
+#include "scan_message.hpp"
 #include "synthetic_scans.hpp"
 #include "traverse/imu_t.hpp"
 #include "traverse/planar_scan_t.hpp"
@@ -75,17 +76,9 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
     } else if (ev->channel == traverse::channels::kScanHorizontal) {
       traverse::planar_scan_t m;
       if (m.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
-      fe::Scan scan;
-      scan.utime_first = m.utime_first;
-      scan.utime_last = m.utime_last;
-      scan.angle_first = m.angle_first;
-      scan.angle_step = m.angle_step;
-      scan.range_min = m.range_min;
-      scan.range_max = m.range_max;
-      scan.ranges = m.ranges;
       if (scans++ == 0) first_utime = m.utime_first;
       last_utime = m.utime_first;
-      pending.push_back(std::move(scan));
+      pending.push_back(traverse::to_planar_scan(m));
     }
   }
   for (const auto& scan : pending) process(scan);

@@ -17,23 +17,14 @@
 #include <vector>
 
 #include "frontend_config.hpp"
+#include "planar_scan.hpp"
 #include "scan_matcher.hpp"
 #include "se2.hpp"
 #include "yaw_integrator.hpp"
 
 namespace traverse::frontend {
 
-// One planar sweep, as planar_scan_t carries it. Beam i is measured at
-// utime_first + i (utime_last - utime_first) / (n - 1) along angle_first + i angle_step.
-struct Scan {
-  int64_t utime_first = 0;    // [us]
-  int64_t utime_last = 0;     // [us]
-  double angle_first = 0.0;   // [rad] in the laser frame
-  double angle_step = 0.0;    // [rad]
-  double range_min = 0.0;     // [m]
-  double range_max = 0.0;     // [m]
-  std::vector<float> ranges;  // [m]
-};
+using Scan = PlanarScan;
 
 enum class ScanStatus {
   kMatched,    // pose measured by matching (the first scan: pose defines the map frame)

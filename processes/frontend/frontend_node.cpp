@@ -1,5 +1,6 @@
 #include "frontend_node.hpp"
 
+#include "scan_message.hpp"
 #include "traverse/pose2d_t.hpp"
 
 namespace traverse::frontend {
@@ -12,15 +13,7 @@ FrontendNode::FrontendNode(Bus& bus, const FrontendConfig& config, CounterSink c
 }
 
 void FrontendNode::on_scan(const planar_scan_t& msg) {
-  Scan scan;
-  scan.utime_first = msg.utime_first;
-  scan.utime_last = msg.utime_last;
-  scan.angle_first = msg.angle_first;
-  scan.angle_step = msg.angle_step;
-  scan.range_min = msg.range_min;
-  scan.range_max = msg.range_max;
-  scan.ranges = msg.ranges;
-  pending_.push_back(std::move(scan));
+  pending_.push_back(to_planar_scan(msg));
   flush();
 }
 
