@@ -14,6 +14,7 @@
 #include "carmen_config.hpp"
 #include "carmen_log.hpp"
 #include "carmen_node.hpp"
+#include "json_escape.hpp"
 #include "process.hpp"
 #include "publisher.hpp"
 
@@ -27,23 +28,6 @@ bool writes_log_file(int argc, char** argv) {
     if (std::strcmp(argv[i], "--out") == 0 || std::strncmp(argv[i], "--out=", 6) == 0) return true;
   }
   return false;
-}
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out;
 }
 
 struct RunFacts {
@@ -82,13 +66,13 @@ void print_summary(const Summary& s, const RunFacts& run, const std::string& out
                   ",\"lines\":" + std::to_string(s.lines) + ",\"scans_by_type\":{";
   bool first = true;
   for (const auto& [type, n] : s.scans_by_type) {
-    j += (first ? "\"" : ",\"") + json_escape(type) + "\":" + std::to_string(n);
+    j += (first ? "\"" : ",\"") + traverse::json_escape(type) + "\":" + std::to_string(n);
     first = false;
   }
   j += "},\"skipped_by_type\":{";
   first = true;
   for (const auto& [type, n] : s.skipped_by_type) {
-    j += (first ? "\"" : ",\"") + json_escape(type) + "\":" + std::to_string(n);
+    j += (first ? "\"" : ",\"") + traverse::json_escape(type) + "\":" + std::to_string(n);
     first = false;
   }
   j += "},\"malformed_count\":" + std::to_string(s.malformed_count) + ",\"malformed_lines\":[";
@@ -111,7 +95,8 @@ void print_summary(const Summary& s, const RunFacts& run, const std::string& out
   std::snprintf(wall, sizeof(wall), "%.3f", run.wall_s);
   j += ",\"wall_s\":" + std::string(wall) +
        ",\"interrupted\":" + (run.interrupted ? "true" : "false") + ",\"input_error\":\"" +
-       json_escape(s.input_error) + "\",\"out\":\"" + json_escape(out_path) + "\"}";
+       traverse::json_escape(s.input_error) + "\",\"out\":\"" + traverse::json_escape(out_path) +
+       "\"}";
   std::printf("%s\n", j.c_str());
   std::fflush(stdout);
 }

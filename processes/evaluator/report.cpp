@@ -8,27 +8,14 @@
 #include <cstdio>
 #include <fstream>
 
+#include "json_escape.hpp"
+
 namespace traverse::evaluator {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / M_PI;
 // Exit code of plot_errors.py when matplotlib cannot be imported.
 constexpr int kNoMatplotlibExitCode = 3;
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
 
 // Runs argv with stdout sent to stderr; the exit code, or -1 if it could not be run.
 int run(const std::vector<std::string>& args) {

@@ -3,24 +3,16 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "json_escape.hpp"
+
 namespace traverse::launch {
 namespace {
 
 std::string quoted(const std::string& s) {
   std::string out = "\"";
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
+  out += json_escape(s);
+  out += '"';
+  return out;
 }
 
 std::string number(double v) {

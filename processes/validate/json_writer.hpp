@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "json_escape.hpp"
+
 namespace traverse::validate {
 
 class JsonWriter {
@@ -50,6 +52,6 @@ class JsonWriter {
   bool after_key_ = false;
 };
 
-std::string json_escape(std::string_view s);
+using ::traverse::json_escape;
 
 }  // namespace traverse::validate
