@@ -60,14 +60,6 @@ fi
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
 out="$ROOT/out/eval/carmen-$name-$(stages_tag "$stages")"
-rm -rf "$out"
-mkdir -p "$out"
-if [[ -z $stages ]]; then
-  evaluate "$cache" POSE_REFERENCE POSE_REFERENCE "$out"
-else
-  estimate="$(estimate_channel "$stages")"
-  run_graph "$cache" "$out" "$stages" "$speed"
-  evaluate "$out/run.lcmlog" "$estimate" POSE_REFERENCE "$out"
-fi
+run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_REFERENCE
 echo "eval-carmen: $name stages ${stages:-none}: outputs in $out" >&2
 merged_json "\"carmen\": $(json_str "$name"), \"stages\": $(json_str "$stages"), \"speed\": $speed, \"input\": $(json_str "$input"), \"lcm_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

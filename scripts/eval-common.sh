@@ -90,6 +90,21 @@ evaluate() {
   fi
 }
 
+# run_and_evaluate IN OUTDIR STAGES SPEED REFERENCE: with no stage, the reference against itself
+# (a smoke test: every error is zero); otherwise the stages run on IN through the graph and the
+# last stage's trajectory is evaluated against REFERENCE. The evaluator's JSON goes to EVAL_JSON.
+run_and_evaluate() {
+  local in="$1" out="$2" stages="$3" speed="$4" ref="$5"
+  rm -rf "$out"
+  mkdir -p "$out"
+  if [[ -z $stages ]]; then
+    evaluate "$in" "$ref" "$ref" "$out"
+  else
+    run_graph "$in" "$out" "$stages" "$speed"
+    evaluate "$out/run.lcmlog" "$(estimate_channel "$stages")" "$ref" "$out"
+  fi
+}
+
 # True when the comma-separated stage list runs the mapper.
 runs_mapper() {
   [[ ,$1, == *,mapper,* || $1 == all ]]

@@ -67,18 +67,10 @@ fi
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
 out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")"
-rm -rf "$out"
-mkdir -p "$out"
-if [[ -z $stages ]]; then
-  evaluate "$cache" POSE_GROUND_TRUTH POSE_GROUND_TRUTH "$out"
-else
-  estimate="$(estimate_channel "$stages")"
-  run_graph "$cache" "$out" "$stages" "$speed"
-  evaluate "$out/run.lcmlog" "$estimate" POSE_GROUND_TRUTH "$out"
-  if runs_mapper "$stages"; then
-    need_programs traverse-cloud-eval
-    cloud_evaluate "$world_file" "$out"
-  fi
+run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_GROUND_TRUTH
+if runs_mapper "$stages"; then
+  need_programs traverse-cloud-eval
+  cloud_evaluate "$world_file" "$out"
 fi
 echo "eval-route: $route seed $seed stages ${stages:-none}: outputs in $out" >&2
 merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -24,17 +24,8 @@ inline PlanarScan sweep(const synthetic::World& world, const Pose2& T_world_base
   spec.utime_first = utime_first;
   spec.range_max = range_max_m;
   spec.noise_sigma_m = noise_m;
-  const frontend::Scan s = synthetic::make_sweep(
+  return synthetic::make_sweep(
       world, [&](int64_t) { return T_world_base; }, Pose2(), spec, &rng);
-  PlanarScan out;
-  out.utime_first = s.utime_first;
-  out.utime_last = s.utime_last;
-  out.angle_first = s.angle_first;
-  out.angle_step = s.angle_step;
-  out.range_min = s.range_min;
-  out.range_max = s.range_max;
-  out.ranges = s.ranges;
-  return out;
 }
 
 // Points of a sweep taken at T_world_base, in the base frame, thinned to 5 cm.
@@ -130,11 +121,8 @@ inline Drive drive_ellipse(double duration_s, unsigned seed = 5) {
   const auto truth_at = [](int64_t t) { return ellipse_pose(1e-6 * static_cast<double>(t)); };
   for (int64_t t0 = 0; 1e-6 * static_cast<double>(t0) < duration_s; t0 += period_us) {
     spec.utime_first = t0;
-    const frontend::Scan s =
-        synthetic::make_sweep(synthetic::room(), truth_at, Pose2(), spec, &rng);
-    PlanarScan scan{s.utime_first, s.utime_last, s.angle_first, s.angle_step,
-                    s.range_min,   s.range_max,  s.ranges};
-    const int64_t t = s.utime_last;
+    PlanarScan scan = synthetic::make_sweep(synthetic::room(), truth_at, Pose2(), spec, &rng);
+    const int64_t t = scan.utime_last;
     d.utimes.push_back(t);
     d.truth.push_back(truth_at(t));
     if (d.input.empty()) {
