@@ -14,7 +14,7 @@ inline const std::string kPoseFrontend = "POSE_FRONTEND";      // pose2d_t, one 
 inline const std::string kKeyPoses = "KEY_POSES";  // key_poses_t, backend key poses (incremental)
 inline const std::string kPoseBackend = "POSE_BACKEND";  // pose2d_t, each backend key pose once
 inline const std::string kPoseDense = "POSE_DENSE";  // pose2d_t, corrected dense trajectory
-inline const std::string kDenseSegment = "DENSE_SEGMENT";  // dense_segment_t, new or moved
+inline const std::string kDenseSegments = "DENSE_SEGMENTS";  // dense_segments_t, new or moved
 
 // LCM's udpm provider sends one message here when an instance starts: not part of any run.
 inline const std::string kLcmSelfTest = "LCM_SELF_TEST";

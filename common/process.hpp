@@ -10,6 +10,13 @@
 //     FrontendNode node(proc.bus(), cfg);
 //     return proc.spin();
 //   }
+//
+// Offline: `--replay IN.lcmlog [--record OUT.lcmlog]` runs the same node on a recorded log instead
+// of a live bus, as fast as it computes and without transport loss: each event of IN is published
+// on an in-process bus (memq://) and handled, with everything the node publishes in answer,
+// before the next event. OUT receives every input and output message in that order, stamped with
+// the time of the input event being handled, so the next process of the graph can replay it in
+// turn and two replays of the same input give the same output.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -40,6 +47,8 @@ class Process {
 
   // Add program-specific options here before start().
   CLI::App& cli() { return app_; }
+  // Adds --replay and --record (see above): for processes of the graph that consume messages.
+  void offer_replay();
 
   // Parses arguments, loads the config file given by --config (if any) into `config`, and
   // connects to LCM unless `connect` is false. Returns an exit code when the program must stop
@@ -68,6 +77,9 @@ class Process {
   // Returns 0, or 1 if LCM failed.
   int spin(const std::function<void()>& tick = {}, const std::function<bool()>& until = {});
 
+  // True when the input is a recorded log (--replay), not a live bus.
+  bool replaying() const { return !replay_path_.empty(); }
+
   // Publishes the status now (drivers with their own loop call this through maybe_publish_status).
   void publish_status(const std::string& state);
   void maybe_publish_status();
@@ -76,12 +88,18 @@ class Process {
   std::optional<int> parse(int argc, char** argv);
   std::optional<int> connect();
   void report_config_error(const ConfigError& e) const;
+  int replay(const std::function<void()>& tick, const std::function<bool()>& until);
+  void drain();  // handles every queued in-process message (replay only)
 
   std::string name_;
   CLI::App app_;
   std::string config_path_;
   std::string lcm_url_;
   std::unique_ptr<Bus> bus_;
+  std::string replay_path_;
+  std::string record_path_;
+  struct Recorder;
+  std::unique_ptr<Recorder> recorder_;
   std::map<std::string, double> counters_;
   int64_t start_utime_ = 0;
   int64_t last_status_utime_ = 0;

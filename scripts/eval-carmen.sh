@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# scripts/eval-carmen.sh NAME|PATH [--stages LIST] [--speed S]
+# scripts/eval-carmen.sh NAME|PATH [--stages LIST] [--speed S] [--offline]
 #
 # One command per evaluation on a real CARMEN log: converts ../shared/data/carmen/NAME-corrected.log.gz
 # (or any CARMEN log PATH) with traverse-carmen (cached as out/cache/carmen-NAME.lcmlog,
@@ -12,7 +12,11 @@
 #   --stages LIST  comma-separated stage names, e.g. frontend (default: none)
 #   --speed S      replay speed through the graph, times the log's pace (default 10: CARMEN scans
 #                  come about every 3 s, far slower than a frontend needs)
+#   --offline      run the stages one after another on the log (--replay/--record) instead of
+#                  live on a bus: no transport loss, as fast as they compute, the same figures
+#                  every time; --speed is then ignored
 set -euo pipefail
+OFFLINE=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -26,6 +30,7 @@ while (($#)); do
   case "$1" in
     --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
     --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
+    --offline) OFFLINE=1; shift ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $what ]] || usage; what="$1"; shift ;;
@@ -62,4 +67,4 @@ fi
 out="$ROOT/out/eval/carmen-$name-$(stages_tag "$stages")"
 run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_REFERENCE
 echo "eval-carmen: $name stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"carmen\": $(json_str "$name"), \"stages\": $(json_str "$stages"), \"speed\": $speed, \"input\": $(json_str "$input"), \"lcm_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+merged_json "\"carmen\": $(json_str "$name"), \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"input\": $(json_str "$input"), \"lcm_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -28,12 +28,14 @@ need_programs() {
 }
 
 # The trajectory channel of the last stage in a comma-separated list; later stages add a line.
+# The backend's and densifier's channels carry revisions (key_poses_t, dense_segments_t): the
+# evaluator keeps the newest of each, so the final trajectory is evaluated, not first estimates.
 estimate_channel() {
   local last="${1##*,}"
   case "$last" in
     frontend) echo POSE_FRONTEND ;;
-    backend) echo POSE_BACKEND ;;
-    densifier | mapper | all) echo POSE_DENSE ;;
+    backend) echo KEY_POSES ;;
+    densifier | mapper | all) echo DENSE_SEGMENTS ;;
     *) die "stage '$last' publishes no trajectory this script knows (add it to estimate_channel)" ;;
   esac
 }
@@ -55,13 +57,15 @@ stale() {
 }
 
 # run_graph IN OUTDIR STAGES SPEED: runs the stages on IN; OUTDIR/run.lcmlog records every
-# channel. Its output goes to OUTDIR/graph.out; its JSON line (if any) is kept in GRAPH_JSON.
+# channel. With OFFLINE=1 the stages run one after another on the log instead of live on a bus
+# (traverse-launch --offline: no transport loss, as fast as they compute, same result each time). Its output goes to OUTDIR/graph.out; its JSON line (if any) is kept in GRAPH_JSON.
 run_graph() {
   local in="$1" out="$2" stages="$3" speed="$4"
   [[ -x $ROOT/scripts/run-graph.sh ]] || die "scripts/run-graph.sh not found"
   local rc=0
   TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$ROOT/configs/deploy/pipeline.yaml" \
-    --log "$in" --out "$out" --speed "$speed" --stages "$stages" >"$out/graph.out" 2>&1 || rc=$?
+    --log "$in" --out "$out" --speed "$speed" --stages "$stages" ${OFFLINE:+--offline} \
+    >"$out/graph.out" 2>&1 || rc=$?
   GRAPH_JSON="$(last_json_line "$out/graph.out")"
   if ((rc != 0)); then
     tail -n 20 "$out/graph.out" >&2

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--speed S] [--duration S]
+# scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--speed S] [--offline] [--duration S]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim (cached as out/cache/ROUTE-seedN.lcmlog, regenerated when the sim program, the
@@ -13,7 +13,11 @@
 #   --speed S      replay speed through the graph, times real time (default 1)
 #   --duration S   simulate only the route's first S seconds (quick checks; cached and evaluated
 #                  under ROUTE-seedN-dS)
+#   --offline      run the stages one after another on the log (--replay/--record) instead of
+#                  live on a bus: no transport loss, as fast as they compute, the same figures
+#                  every time; --speed is then ignored
 set -euo pipefail
+OFFLINE=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -28,6 +32,7 @@ while (($#)); do
     --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
     --seed) seed="${2:?--seed needs a number}"; shift 2 ;;
     --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
+    --offline) OFFLINE=1; shift ;;
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
@@ -73,4 +78,4 @@ if runs_mapper "$stages"; then
   cloud_evaluate "$world_file" "$out"
 fi
 echo "eval-route: $route seed $seed stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -24,6 +24,7 @@ Eigen::Matrix3d to_pose_frame(const Eigen::Matrix3d& covariance_world, const Pos
 
 std::string validate(const BackendConfig& c) {
   if (auto e = validate(c.link); !e.empty()) return "link." + e;
+  if (auto e = validate(c.link_refine); !e.empty()) return "link_refine." + e;
   if (auto e = validate(c.loop); !e.empty()) return "loop." + e;
   if (auto e = validate(c.spa); !e.empty()) return "spa." + e;
   if (c.link_chain_length < 1) return "link_chain_length must be >= 1";
@@ -44,6 +45,7 @@ Backend::Backend(BackendConfig config)
       T_base_laser_(config_.T_base_laser.x_m, config_.T_base_laser.y_m,
                     config_.T_base_laser.theta_rad),
       link_matcher_(config_.link),
+      link_refiner_(config_.link_refine),
       loop_(config_.loop),
       spa_(config_.spa) {}
 
@@ -76,8 +78,36 @@ Pose2 Backend::smooth(int64_t utime, const Pose2& T_map_base) {
   return smoothed;
 }
 
+bool Backend::is_outlier(const StampedPose& held, const StampedPose& next) const {
+  if (tail_.empty()) return false;
+  // The two raw steps appended to the smoothed tail, as smooth() would append them.
+  std::vector<StampedPose> window = tail_;
+  window.push_back({held.utime, tail_.back().T_world_base * between(last_raw_, held.T_world_base)});
+  window.push_back({next.utime, tail_.back().T_world_base * between(last_raw_, next.T_world_base)});
+  const SmoothedTrajectory s = smooth_jumps(std::move(window), config_.smoothing);
+  return !s.outliers.empty() && s.outliers.back() == static_cast<int>(tail_.size());
+}
+
 std::optional<BackendUpdate> Backend::add_pose(int64_t utime, const Pose2& T_map_base) {
   ++counters_.poses;
+  const StampedPose next{utime, T_map_base};
+  if (!held_) {
+    held_ = next;
+    return std::nullopt;
+  }
+  StampedPose pose = *held_;
+  held_ = next;
+  if (is_outlier(pose, next)) {
+    ++counters_.outliers_replaced;
+    const double s = static_cast<double>(pose.utime - last_key_input_utime_) /
+                     static_cast<double>(std::max<int64_t>(1, next.utime - last_key_input_utime_));
+    pose.T_world_base = interpolate(last_raw_, next.T_world_base, s);
+  }
+  return take_pose(pose.utime, pose.T_world_base);
+}
+
+std::optional<BackendUpdate> Backend::take_pose(int64_t utime, const Pose2& T_map_base) {
+  last_key_input_utime_ = utime;
   const Pose2 smoothed = smooth(utime, T_map_base);
   since_key_.push_back({utime, smoothed});
   const bool first = key_poses_.empty() && since_key_.size() == 1;
@@ -143,7 +173,18 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     if (m.valid && m.raw_response >= config_.min_link_response) {
       ++counters_.links_matched;
       T_world_key = m.T_world_query;
-      covariance = to_pose_frame(m.covariance, T_world_key);
+      if (config_.link_refine.enabled) {
+        const RefineResult r = link_refiner_.refine(reference, scans_.points_d(index), T_world_key);
+        if (r.valid) {
+          ++counters_.links_refined;
+          T_world_key = r.T_world_query;
+        }
+      }
+      // The response spread says nothing of the grid itself: a match on cells of r metres and
+      // steps of a radians is uncertain by at least r^2 / 12 and a^2 / 12 (uniform rounding).
+      const double r = config_.link.resolution_m, a = config_.link.angle_step_rad;
+      covariance = to_pose_frame(m.covariance, T_world_key) +
+                   Eigen::Vector3d(r * r / 12.0, r * r / 12.0, a * a / 12.0).asDiagonal().toDenseMatrix();
     } else {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;
@@ -209,11 +250,26 @@ std::optional<BackendUpdate> Backend::optimise() {
 }
 
 std::optional<BackendUpdate> Backend::finish() {
+  std::optional<BackendUpdate> last;
+  if (held_) {
+    const StampedPose pose = *held_;
+    held_.reset();
+    last = take_pose(pose.utime, pose.T_world_base);
+  }
   const std::optional<LoopClosure> closure = loop_.finish();
   if (closure) add_closure(*closure);
   if (key_poses_.empty()) return std::nullopt;
-  if (closure || first_unreported_key_ < static_cast<int>(key_poses_.size())) return optimise();
-  return std::nullopt;
+  if (closure || first_unreported_key_ < static_cast<int>(key_poses_.size())) {
+    std::optional<BackendUpdate> update = optimise();
+    if (last && update) {  // one update reports both
+      update->new_key_poses.insert(update->new_key_poses.begin(), last->new_key_poses.begin(),
+                                   last->new_key_poses.end());
+      update->new_closures.insert(update->new_closures.begin(), last->new_closures.begin(),
+                                  last->new_closures.end());
+    }
+    return update;
+  }
+  return last;
 }
 
 }  // namespace traverse::backend

@@ -50,6 +50,8 @@ struct BackendConfig {
   // Links between consecutive key poses: a narrow search with a strong penalty, so the result
   // follows the frontend unless the scans clearly say otherwise (seed 000).
   CorrelativeMatcherConfig link{0.02, 8, 0.003, 0.2, 0.06, 0.03, 0.2, 0.1, 0.05, 8, 400};
+  // ... then refined point to line (scan_refiner.hpp); the link keeps the correlative covariance.
+  RefinerConfig link_refine;
   int link_chain_length = 5;               // previous key scans a new key scan is matched against
   double min_link_response = 0.35;         // below: the frontend's relative motion is used instead
   double fallback_sigma_xy_m = 0.05;       // its standard deviation [m]
@@ -72,6 +74,7 @@ struct BackendConfig {
     v("key_poses", key_poses);
     v("scans", scans);
     v("link", link);
+    v("link_refine", link_refine);
     v("link_chain_length", link_chain_length);
     v("min_link_response", min_link_response);
     v("fallback_sigma_xy_m", fallback_sigma_xy_m);
@@ -108,9 +111,11 @@ struct BackendUpdate {
 struct BackendCounters {
   long poses = 0;                   // frontend poses received
   long jumps_smoothed = 0;          // frontend steps replaced by the average
+  long outliers_replaced = 0;       // single frontend poses replaced by their neighbours' average
   long scans = 0;                   // scans received
   long key_poses_without_scan = 0;  // key pose deferred: its scan was missing
   long links_matched = 0;           // consecutive links from correlative matching
+  long links_refined = 0;           // ... of which refined point to line
   long links_fallback = 0;          // ... from the frontend's motion (response too low)
   long optimisations = 0;
   long optimisations_failed = 0;      // not converged or covariance not recovered
@@ -126,7 +131,8 @@ class Backend {
   // A scan of the horizontal scanner (before its frontend pose arrives).
   void add_scan(PlanarScan scan);
   // The frontend pose of the scan ending at `utime`; returns an update when the graph was
-  // optimised.
+  // optimised. Each pose is taken in when the next one arrives (or at finish()): only then can it
+  // be told apart from an outlier.
   std::optional<BackendUpdate> add_pose(int64_t utime, const Pose2& T_map_base);
   // End of data: closes an open loop-closure episode and optimises if anything is new.
   std::optional<BackendUpdate> finish();
@@ -138,9 +144,13 @@ class Backend {
   const LoopCloserCounters& loop_counters() const { return loop_.counters(); }
   const BackendCounters& counters() const { return counters_; }
   int analyses() const { return spa_.system().analyses(); }
+  int orderings_reused() const { return spa_.system().orderings_reused(); }
 
  private:
   Pose2 smooth(int64_t utime, const Pose2& T_map_base);
+  // Whether the held pose is an outlier that `next` returns from (see smooth_jumps).
+  bool is_outlier(const StampedPose& held, const StampedPose& next) const;
+  std::optional<BackendUpdate> take_pose(int64_t utime, const Pose2& T_map_base);
   // Adds the key pose at the newest smoothed pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
   void add_closure(const LoopClosure& closure);
@@ -149,11 +159,14 @@ class Backend {
   BackendConfig config_;
   Pose2 T_base_laser_;
   CorrelativeMatcher link_matcher_;
+  ScanRefiner link_refiner_;
   LoopCloser loop_;
   SpaOptimizer spa_;
   BackendCounters counters_;
 
   std::deque<PlanarScan> pending_scans_;
+  std::optional<StampedPose> held_;     // the newest frontend pose, not yet taken in
+  int64_t last_key_input_utime_ = 0;    // [us] time of the last pose taken in
   std::vector<StampedPose> tail_;       // the last smoothed poses (window + 1)
   Pose2 last_raw_;                      // the previous frontend pose
   std::vector<StampedPose> since_key_;  // smoothed poses since the last key pose (inclusive)

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
                          "Pose-graph backend: correlative matching, best-of-candidates loop "
                          "closure, SPA, marginal covariances of the key poses");
   traverse::backend::BackendNodeConfig config;
+  proc.offer_replay();
   if (auto rc = proc.start(argc, argv, config)) return *rc;
   if (const std::string error = traverse::backend::validate(config); !error.empty()) {
     std::cerr << "traverse-backend: " << proc.config_path() << ": " << error << "\n";

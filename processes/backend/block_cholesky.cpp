@@ -117,6 +117,45 @@ bool BlockCholesky::factorize_damped() {
   return ok && common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
 }
 
+bool BlockCholesky::extends_last_ordering() const {
+  const int nb = num_blocks_, old = static_cast<int>(ordered_upper_.size());
+  if (block_perm_.empty() || nb <= old || 4 * (nb - fully_ordered_blocks_) > fully_ordered_blocks_) {
+    return false;
+  }
+  for (int j = 0; j < old; ++j) {
+    if (upper_neighbours_[j] != ordered_upper_[j]) return false;
+  }
+  for (int j = old; j < nb; ++j) {
+    for (int i : upper_neighbours_[j]) {
+      if (i < old - 1) return false;  // linked to an older block than the newest: a loop
+    }
+  }
+  return true;
+}
+
+bool BlockCholesky::order_blocks(std::vector<int>& block_perm) {
+  const int nb = num_blocks_;
+  std::size_t nnz = 0;
+  for (const auto& rows : upper_neighbours_) nnz += rows.size() + 1;
+  cholmod_sparse* B = cholmod_allocate_sparse(nb, nb, nnz, 1, 1, 1, CHOLMOD_PATTERN, &common_);
+  if (!B) return false;
+  auto* bp = static_cast<int*>(B->p);
+  auto* bi = static_cast<int*>(B->i);
+  int pos = 0;
+  for (int j = 0; j < nb; ++j) {
+    bp[j] = pos;
+    for (int i : upper_neighbours_[j]) bi[pos++] = i;
+    bi[pos++] = j;
+  }
+  bp[nb] = pos;
+  block_perm.resize(nb);
+  const int ok = ordering_ == Ordering::kBlockAmd
+                     ? cholmod_amd(B, nullptr, 0, block_perm.data(), &common_)
+                     : cholmod_metis(B, nullptr, 0, /*postorder=*/1, block_perm.data(), &common_);
+  cholmod_free_sparse(&B, &common_);
+  return ok;
+}
+
 bool BlockCholesky::analyse() {
   if (factor_) cholmod_free_factor(&factor_, &common_);
   if (ordering_ == Ordering::kScalarDefault) {
@@ -124,28 +163,21 @@ bool BlockCholesky::analyse() {
   } else {
     // Order the graph of blocks (9 times fewer entries), then keep each block's 3 scalars
     // together; CHOLMOD postorders the given permutation and finds the supernodes.
-    const int nb = num_blocks_;
-    std::size_t nnz = 0;
-    for (const auto& rows : upper_neighbours_) nnz += rows.size() + 1;
-    cholmod_sparse* B = cholmod_allocate_sparse(nb, nb, nnz, 1, 1, 1, CHOLMOD_PATTERN, &common_);
-    if (!B) return false;
-    auto* bp = static_cast<int*>(B->p);
-    auto* bi = static_cast<int*>(B->i);
-    int pos = 0;
-    for (int j = 0; j < nb; ++j) {
-      bp[j] = pos;
-      for (int i : upper_neighbours_[j]) bi[pos++] = i;
-      bi[pos++] = j;
+    std::vector<int> block_perm;
+    if (extends_last_ordering()) {
+      block_perm = block_perm_;
+      for (int j = static_cast<int>(block_perm_.size()); j < num_blocks_; ++j) {
+        block_perm.push_back(j);
+      }
+      ++orderings_reused_;
+    } else {
+      if (!order_blocks(block_perm)) return false;
+      fully_ordered_blocks_ = num_blocks_;
     }
-    bp[nb] = pos;
-    std::vector<int> block_perm(nb);
-    const int ok = ordering_ == Ordering::kBlockAmd
-                       ? cholmod_amd(B, nullptr, 0, block_perm.data(), &common_)
-                       : cholmod_metis(B, nullptr, 0, /*postorder=*/1, block_perm.data(), &common_);
-    cholmod_free_sparse(&B, &common_);
-    if (!ok) return false;
-    std::vector<int> perm(3 * static_cast<std::size_t>(nb));
-    for (int r = 0; r < nb; ++r) {
+    block_perm_ = block_perm;
+    ordered_upper_ = upper_neighbours_;
+    std::vector<int> perm(3 * static_cast<std::size_t>(num_blocks_));
+    for (int r = 0; r < num_blocks_; ++r) {
       for (int u = 0; u < 3; ++u) perm[3 * r + u] = 3 * block_perm[r] + u;
     }
     common_.nmethods = 1;

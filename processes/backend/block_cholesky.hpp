@@ -4,7 +4,12 @@
 // directly into the compressed-column arrays: the position of every block is computed once per
 // sparsity pattern, so a linearisation only zeroes and accumulates values. The symbolic analysis
 // (fill- reducing ordering and elimination tree, cholmod_analyze) is done once per pattern and
-// reused by every numeric factorisation until the pattern changes.
+// reused by every numeric factorisation until the pattern changes. When the pattern changes only
+// by blocks appended at the end and linked to the newest old block (a growing chain of key poses
+// between loop closures), the block ordering of the previous analysis is kept and extended by the
+// new blocks instead of being recomputed; CHOLMOD then redoes only the elimination tree and
+// column counts (linear in the non-zeros). A new edge between old blocks (a loop closure), or a
+// quarter more blocks than at the last full ordering, orders afresh.
 #pragma once
 
 #include <cholmod.h>
@@ -62,8 +67,10 @@ class BlockCholesky {
   // The last numeric factor (CHOLMOD ordering and storage); null before factorize.
   const cholmod_factor* factor() const { return factor_; }
   cholmod_common* common() { return &common_; }
-  // Number of symbolic analyses done so far (for checking reuse).
+  // Number of symbolic analyses done so far (for checking reuse), and how many of them reused
+  // the previous ordering extended by appended blocks.
   int analyses() const { return analyses_; }
+  int orderings_reused() const { return orderings_reused_; }
   // Non-zeros of the upper triangle of H and of the last factor L.
   long nnz_h() const;
   long nnz_l() const;
@@ -77,6 +84,10 @@ class BlockCholesky {
   void free_all();
   bool factorize_damped();
   bool analyse();
+  // Whether the pattern only appends blocks to the last analysed one (see the top).
+  bool extends_last_ordering() const;
+  // Fill-reducing ordering of the block graph (AMD or METIS).
+  bool order_blocks(std::vector<int>& block_perm);
 
   Ordering ordering_;
   cholmod_common common_;
@@ -87,7 +98,12 @@ class BlockCholesky {
   std::vector<Slot> slots_;
   Eigen::VectorXd damping_;
   int analyses_ = 0;
+  int orderings_reused_ = 0;
   bool analysed_ = false;
+  // The pattern and block ordering of the last analysis, and the size at the last full ordering.
+  std::vector<std::vector<int>> ordered_upper_;
+  std::vector<int> block_perm_;
+  int fully_ordered_blocks_ = 0;
 };
 
 }  // namespace traverse::backend

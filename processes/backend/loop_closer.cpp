@@ -19,11 +19,15 @@ std::string validate(const LoopCloserConfig& c) {
   }
   if (auto e = validate(c.coarse); !e.empty()) return "coarse." + e;
   if (auto e = validate(c.fine); !e.empty()) return "fine." + e;
+  if (auto e = validate(c.refine); !e.empty()) return "refine." + e;
   return {};
 }
 
 LoopCloser::LoopCloser(LoopCloserConfig config)
-    : config_(std::move(config)), coarse_(config_.coarse), fine_(config_.fine) {}
+    : config_(std::move(config)),
+      coarse_(config_.coarse),
+      fine_(config_.fine),
+      refiner_(config_.refine) {}
 
 std::optional<LoopClosure> LoopCloser::try_candidate(
     int current, int chain_first, int chain_last, const std::vector<Pose2>& poses,
@@ -58,9 +62,21 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
     return std::nullopt;
   }
 
+  Pose2 T_world_current = fine.T_world_query;
+  Eigen::Matrix3d covariance = fine.covariance;
+  if (config_.refine.enabled) {
+    const RefineResult refined = refiner_.refine(reference, query, fine.T_world_query);
+    if (refined.valid) {
+      ++counters_.refined;
+      T_world_current = refined.T_world_query;
+      if (config_.refined_covariance) covariance = refined.covariance;
+    } else {
+      ++counters_.refine_failed;
+    }
+  }
+
   LoopClosure closure;
   closure.to = current;
-  const Pose2& T_world_current = fine.T_world_query;
   double nearest = 1e300;
   for (int j = chain_first; j <= chain_last; ++j) {
     const double d = (poses[j].translation() - T_world_current.translation()).norm();
@@ -72,7 +88,7 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
     const Eigen::Vector3d d(T_world_current.x() - poses[current].x(),
                             T_world_current.y() - poses[current].y(),
                             wrap_angle(T_world_current.theta() - poses[current].theta()));
-    const Eigen::Matrix3d S = fine.covariance + (*marginals)[closure.from] + (*marginals)[current];
+    const Eigen::Matrix3d S = covariance + (*marginals)[closure.from] + (*marginals)[current];
     if (std::sqrt(d.dot(S.ldlt().solve(d))) > config_.max_correction_mahalanobis) {
       ++counters_.rejected_inconsistent;
       return std::nullopt;
@@ -82,7 +98,7 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   // of the `to` pose.
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   R.topLeftCorner<2, 2>() = T_world_current.rotation().transpose();
-  closure.covariance = R * fine.covariance * R.transpose();
+  closure.covariance = R * covariance * R.transpose();
   closure.response = fine.raw_response;
   closure.second_peak = ambiguity;
   return closure;

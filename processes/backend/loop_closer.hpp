@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "correlative_matcher.hpp"
+#include "scan_refiner.hpp"
 #include "scan_store.hpp"
 #include "se2.hpp"
 
@@ -51,6 +52,12 @@ struct LoopCloserConfig {
   CorrelativeMatcherConfig coarse{0.05, 8, 0.01, 2.0, 0.35, 0.06, 10.0, 2.0, 0.05, 10, 300};
   // Fine: around the coarse peak on a 2 cm grid.
   CorrelativeMatcherConfig fine{0.02, 4, 0.002, 0.12, 0.03, 0.03, 10.0, 2.0, 0.05, 8, 400};
+  // Then point-to-line refinement of the fine match (scan_refiner.hpp): the closure takes its pose
+  // and keeps the fine match's covariance. The refinement's own covariance was measured too
+  // tight on the simulated office (closure heading errors of 1e-4 rad against 2e-5 rad), and
+  // weighting closures by it made the trajectory worse (2.5 mm against 0.96 mm position RMSE).
+  RefinerConfig refine;
+  bool refined_covariance = false;  // the closure takes the refinement's covariance instead
 
   template <class V>
   void visit(V& v) {
@@ -68,6 +75,8 @@ struct LoopCloserConfig {
     v("max_correction_mahalanobis", max_correction_mahalanobis);
     v("coarse", coarse);
     v("fine", fine);
+    v("refine", refine);
+    v("refined_covariance", refined_covariance);
   }
 };
 
@@ -91,6 +100,8 @@ struct LoopCloserCounters {
   long rejected_response = 0;  // coarse or fine response too low
   long rejected_ambiguous = 0;
   long rejected_covariance = 0;
+  long refined = 0;        // fine matches refined point to line
+  long refine_failed = 0;  // ... where refinement failed (the fine match is kept)
   long rejected_inconsistent = 0;  // correction too large for the marginals
   long closures = 0;
 };
@@ -121,6 +132,7 @@ class LoopCloser {
  private:
   LoopCloserConfig config_;
   CorrelativeMatcher coarse_, fine_;
+  ScanRefiner refiner_;
   LoopCloserCounters counters_;
   bool open_ = false;
   int chain_first_ = 0, chain_last_ = 0;  // chain of the open episode

@@ -9,12 +9,22 @@ namespace {
 
 // A step as a body-frame velocity: (vx [m/s], vy [m/s], omega [rad/s]).
 Eigen::Vector3d velocity(const StampedPose& a, const StampedPose& b) {
-  const double dt = 1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1));
   const Pose2 step = between(a.T_world_base, b.T_world_base);
-  return Eigen::Vector3d(step.x(), step.y(), step.theta()) / dt;
+  return Eigen::Vector3d(step.x(), step.y(), step.theta()) /
+         (1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1)));
 }
 
-bool is_jump(const Eigen::Vector3d& v, const Eigen::Vector3d& mean, const JumpSmoothingConfig& c) {
+double seconds(const StampedPose& a, const StampedPose& b) {
+  return 1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1));
+}
+
+// Whether velocity v over dt [s] is a jump against the mean velocity of the preceding steps.
+bool is_jump(const Eigen::Vector3d& v, double dt, const Eigen::Vector3d& mean,
+             const JumpSmoothingConfig& c) {
+  const Eigen::Vector3d deviation = (v - mean) * dt;
+  if (deviation.head<2>().norm() <= c.min_jump_m && std::abs(deviation.z()) <= c.min_jump_rad) {
+    return false;
+  }
   const double speed = v.head<2>().norm(), mean_speed = mean.head<2>().norm();
   if (speed > c.min_jump_speed_mps && speed > c.speed_ratio * mean_speed) return true;
   if (std::abs(v.z()) > c.max_turn_rate_radps) return true;
@@ -27,19 +37,37 @@ bool is_jump(const Eigen::Vector3d& v, const Eigen::Vector3d& mean, const JumpSm
 
 }  // namespace
 
-SmoothedTrajectory smooth_jumps(const std::vector<StampedPose>& poses,
-                                const JumpSmoothingConfig& config) {
+SmoothedTrajectory smooth_jumps(std::vector<StampedPose> poses, const JumpSmoothingConfig& config) {
   SmoothedTrajectory out;
   if (poses.empty()) return out;
   out.poses.push_back(poses.front());
   std::deque<Eigen::Vector3d> recent;  // velocities of the preceding (accepted) steps
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (std::size_t k = 1; k < poses.size(); ++k) {
+    // An outlier: pose k lies off the path from k - 1 to k + 1 by more than the minimum and
+    // more than half that path's length (or turn), so it is not a curve of it, while that path
+    // itself moves as the preceding steps did (else pose k + 1 shares a jump).
+    const bool judged = static_cast<int>(recent.size()) == config.window;
+    if (judged && k + 1 < poses.size()) {
+      const Eigen::Vector3d mean = sum / static_cast<double>(recent.size());
+      const double s = seconds(poses[k - 1], poses[k]) / seconds(poses[k - 1], poses[k + 1]);
+      const Pose2 on_path = interpolate(poses[k - 1].T_world_base, poses[k + 1].T_world_base, s);
+      const Pose2 off = between(on_path, poses[k].T_world_base);
+      const Pose2 path = between(poses[k - 1].T_world_base, poses[k + 1].T_world_base);
+      const bool off_path =
+          off.translation().norm() > std::max(config.min_jump_m, 0.5 * path.translation().norm()) ||
+          std::abs(off.theta()) > std::max(config.min_jump_rad, 0.5 * std::abs(path.theta()));
+      if (off_path && !is_jump(velocity(poses[k - 1], poses[k + 1]),
+                               seconds(poses[k - 1], poses[k + 1]), mean, config)) {
+        poses[k].T_world_base = on_path;
+        out.outliers.push_back(static_cast<int>(k));
+      }
+    }
     Eigen::Vector3d v = velocity(poses[k - 1], poses[k]);
     // Only judge once the window is full: the average must describe the recent motion.
-    if (static_cast<int>(recent.size()) == config.window) {
+    if (judged) {
       const Eigen::Vector3d mean = sum / static_cast<double>(recent.size());
-      if (is_jump(v, mean, config)) {
+      if (is_jump(v, seconds(poses[k - 1], poses[k]), mean, config)) {
         v = mean;
         out.replaced_steps.push_back(static_cast<int>(k));
       }
@@ -51,8 +79,7 @@ SmoothedTrajectory smooth_jumps(const std::vector<StampedPose>& poses,
       recent.pop_front();
     }
     // Carry the rest of the trajectory along: compose the (possibly replaced) step.
-    const double dt =
-        1e-6 * static_cast<double>(std::max<int64_t>(poses[k].utime - poses[k - 1].utime, 1));
+    const double dt = seconds(poses[k - 1], poses[k]);
     const Pose2 step(v.x() * dt, v.y() * dt, v.z() * dt);
     out.poses.push_back({poses[k].utime, out.poses.back().T_world_base * step});
   }

@@ -3,7 +3,11 @@
 //     with a discrete jump. Each step between consecutive poses is compared with the average of
 //     the preceding steps (as velocities, so uneven scan timing does not matter); a step much
 //     longer, or in a clearly different direction, is replaced by that average, and the rest of
-//     the trajectory is carried along so it stays continuous.
+//     the trajectory is carried along so it stays continuous. A single bad pose that the next pose
+//     returns from (it lies off the path between its neighbours by more than half that path's
+//     length) is an outlier, not a jump: it is replaced by interpolating its neighbours, and
+//     nothing after it moves. Deviations from the average motion below min_jump_m / min_jump_rad are never jumps:
+//     they are scan-matching noise that the backend's own matching handles.
 //  2. Key-pose selection: a pose becomes a key pose when enough time has passed since the last
 //     one (seed 000 uses three per second), or when the platform has moved or turned enough.
 // Poses are T_world_base, times in microseconds.
@@ -28,6 +32,8 @@ struct JumpSmoothingConfig {
   double max_direction_change_rad = 1.0;  // step direction vs average direction, while moving
   double min_moving_speed_mps = 0.1;  // below this average speed, direction is not checked [m/s]
   double max_turn_rate_radps = 3.0;   // a heading rate above this [rad/s] is a jump
+  double min_jump_m = 0.005;    // a jump displaces the pose by more than this from the average [m]
+  double min_jump_rad = 0.005;  // ... or turns it by more than this [rad]
 
   template <class V>
   void visit(V& v) {
@@ -37,18 +43,21 @@ struct JumpSmoothingConfig {
     v("max_direction_change_rad", max_direction_change_rad);
     v("min_moving_speed_mps", min_moving_speed_mps);
     v("max_turn_rate_radps", max_turn_rate_radps);
+    v("min_jump_m", min_jump_m);
+    v("min_jump_rad", min_jump_rad);
   }
 };
 
 struct SmoothedTrajectory {
   std::vector<StampedPose> poses;
   std::vector<int> replaced_steps;  // index k of every step k-1 -> k replaced by the average
+  std::vector<int> outliers;        // index k of every pose replaced by its neighbours' average
 };
 
-// Returns the trajectory with jumps replaced; the first pose is kept as is. Poses must be in
-// time order (equal times are treated as a 1 us step).
-SmoothedTrajectory smooth_jumps(const std::vector<StampedPose>& poses,
-                                const JumpSmoothingConfig& config);
+// Returns the trajectory with jumps and outliers replaced; the first pose is kept as is, and the
+// last is never an outlier (nothing follows it). Poses must be in time order (equal times are
+// treated as a 1 us step).
+SmoothedTrajectory smooth_jumps(std::vector<StampedPose> poses, const JumpSmoothingConfig& config);
 
 struct KeyPoseConfig {
   int64_t interval_us = 333333;  // a key pose at least this often [us]; 0: not by time

@@ -49,6 +49,12 @@ struct Scan {
   std::string type;   // "FLASER" or "ROBOTLASER1"
   int64_t line = 0;   // line number in the log, from 1
   int64_t utime = 0;  // [us] ipc timestamp of the scan (one per scan in CARMEN)
+  // [s] Resolution of the timestamp as printed: the place value of its last digit (1e-6 for
+  // "12.345678", 1e4 for "1.13486e+09", a log printed with 6 significant digits).
+  double utime_quantum_s = 0.0;
+  // The logger timestamp (the line's last field) and its resolution, when it parses.
+  std::optional<int64_t> logger_utime;
+  double logger_quantum_s = 0.0;
   BeamAngles beams;
   std::vector<float> ranges;          // [m]
   std::optional<double> range_max_m;  // [m] stated by the message (ROBOTLASER1), if any
@@ -86,14 +92,32 @@ struct Summary {
   int64_t backwards_count = 0;
   std::vector<int64_t> backwards_lines;  // the first `kListed`
   int64_t max_backstep_us = 0;           // [us] largest correction made
-  std::string input_error;               // empty when the whole file was read
+  // Scans whose ipc timestamp is coarser than TimestampPolicy::max_quantum_s (csail: printed with
+  // 6 significant digits, 1e4 s steps): restamped from the logger timestamp when that is fine
+  // enough, else spaced at the nominal period after the previous scan.
+  int64_t quantised_count = 0;
+  double max_quantum_s = 0.0;  // [s] coarsest timestamp resolution seen (ipc)
+  int64_t restamped_logger = 0;
+  int64_t restamped_nominal = 0;
+  std::string input_error;  // empty when the whole file was read
   static constexpr std::size_t kListed = 100;
 };
+
+// What to do with timestamps printed too coarsely to order or space scans.
+struct TimestampPolicy {
+  double max_quantum_s = 1.0;     // [s] coarser timestamps are quantised
+  double nominal_period_s = 3.0;  // [s] spacing of quantised scans when no finer clock exists
+};
+
+// Resolution [s] of a printed number: the place value of its last mantissa digit, times the
+// exponent ("1.5e3" -> 100, "0.25" -> 0.01, "7" -> 1).
+double printed_quantum(std::string_view token);
 
 // Reads a CARMEN log line by line; gzip is detected from the content, not the name.
 class Reader {
  public:
-  explicit Reader(const std::string& path, FlaserGeometry geometry = FlaserGeometry::kStandard);
+  explicit Reader(const std::string& path, FlaserGeometry geometry = FlaserGeometry::kStandard,
+                  TimestampPolicy timestamps = {});
   ~Reader();
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
@@ -109,6 +133,7 @@ class Reader {
   struct GzFile;
   std::unique_ptr<GzFile> file_;
   FlaserGeometry geometry_;
+  TimestampPolicy timestamps_;
   bool good_ = false;
   bool eof_ = false;
   bool line_too_long_ = false;  // the line just read was cut at kMaxLineBytes

@@ -39,7 +39,8 @@ struct RunFacts {
   bool interrupted = false;
 };
 
-void print_summary(const Summary& s, const RunFacts& run, const std::string& out_path) {
+void print_summary(const Summary& s, const RunFacts& run, const std::string& out_path,
+                   double nominal_period_s) {
   std::printf("lines read:        %lld\n", static_cast<long long>(s.lines));
   for (const auto& [type, n] : s.scans_by_type) {
     std::printf("scans (%s): %lld\n", type.c_str(), static_cast<long long>(n));
@@ -58,6 +59,13 @@ void print_summary(const Summary& s, const RunFacts& run, const std::string& out
         "time going back:   %lld scans stamped before the previous one (by up to %.3f s), "
         "restamped 1 us after it\n",
         static_cast<long long>(s.backwards_count), 1e-6 * s.max_backstep_us);
+  }
+  if (s.quantised_count) {
+    std::printf(
+        "quantised time:    %lld scans stamped to %.6g s only: %lld restamped from the logger "
+        "timestamp, %lld spaced at the nominal period\n",
+        static_cast<long long>(s.quantised_count), s.max_quantum_s,
+        static_cast<long long>(s.restamped_logger), static_cast<long long>(s.restamped_nominal));
   }
   if (!s.input_error.empty()) std::printf("input error:       %s\n", s.input_error.c_str());
 
@@ -89,6 +97,15 @@ void print_summary(const Summary& s, const RunFacts& run, const std::string& out
     j += std::to_string(s.backwards_lines[i]);
   }
   j += "],\"max_backstep_us\":" + std::to_string(s.max_backstep_us);
+  char quantum[160];
+  std::snprintf(quantum, sizeof(quantum),
+                ",\"timestamp_quantum_s\":%.6g,\"quantised_timestamps\":%lld,"
+                "\"restamped_from_logger\":%lld,\"restamped_nominal\":%lld,"
+                "\"nominal_scan_period_s\":%.6g",
+                s.max_quantum_s, static_cast<long long>(s.quantised_count),
+                static_cast<long long>(s.restamped_logger),
+                static_cast<long long>(s.restamped_nominal), nominal_period_s);
+  j += quantum;
   j += ",\"first_utime\":" + std::to_string(run.first_utime) +
        ",\"last_utime\":" + std::to_string(run.last_utime);
   char wall[64];
@@ -141,7 +158,15 @@ int main(int argc, char** argv) {
     spdlog::error("traverse-carmen: no CARMEN log given (see --help)");
     return traverse::kConfigErrorExitCode;
   }
-  traverse::carmen::Reader reader(log_path, *geometry);
+  if (!(cfg.max_timestamp_quantum_s > 0.0 && cfg.nominal_scan_period_s > 0.0)) {
+    spdlog::error(
+        "traverse-carmen: config error: {}: max_timestamp_quantum_s and nominal_scan_period_s "
+        "must be positive",
+        proc.config_path().empty() ? "(defaults)" : proc.config_path());
+    return traverse::kConfigErrorExitCode;
+  }
+  traverse::carmen::Reader reader(log_path, *geometry,
+                                  {cfg.max_timestamp_quantum_s, cfg.nominal_scan_period_s});
   if (!reader.good()) {
     spdlog::error("traverse-carmen: cannot read '{}'", log_path);
     return 1;
@@ -185,6 +210,7 @@ int main(int argc, char** argv) {
   file.reset();  // close the log before reporting
   const bool damaged = !reader.summary().input_error.empty();
   if (damaged) spdlog::error("traverse-carmen: {}", reader.summary().input_error);
-  print_summary(reader.summary(), run, out_path);  // JSON last, also when stderr is merged
+  print_summary(reader.summary(), run, out_path,
+                cfg.nominal_scan_period_s);  // JSON last, also when stderr is merged
   return damaged ? 1 : 0;
 }

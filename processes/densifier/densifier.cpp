@@ -166,8 +166,14 @@ std::vector<StampedPose> Densifier::dense_between(int64_t t0, int64_t t1) const 
   return out;
 }
 
+std::vector<Segment> Densifier::settle() {
+  std::vector<Segment> out;
+  for (auto it = keys_.begin(); it != keys_.end(); ++it) refresh_segment(it, out, true);
+  return out;
+}
+
 void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it,
-                                std::vector<Segment>& out) {
+                                std::vector<Segment>& out, bool exact) {
   if (it == keys_.end()) return;
   auto next = std::next(it);
   if (next == keys_.end() || !it->second.placed || !next->second.placed) return;
@@ -182,8 +188,10 @@ void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it,
   for (std::size_t i = 0; !changed && i < poses.size(); ++i) {
     const Pose2& p = poses[i].T_world_base;
     const Pose2& q = seg.poses[i].T_world_base;
-    changed = (p.translation() - q.translation()).norm() > config_.republish_threshold_m ||
-              std::abs(wrap_angle(p.theta() - q.theta())) > config_.republish_threshold_rad;
+    const double dm = (p.translation() - q.translation()).norm();
+    const double dr = std::abs(wrap_angle(p.theta() - q.theta()));
+    changed = exact ? (dm > 0.0 || dr > 0.0)
+                    : (dm > config_.republish_threshold_m || dr > config_.republish_threshold_rad);
   }
   if (!changed) return;
   if (seg.revision >= 0) ++segments_moved_;

@@ -38,6 +38,8 @@ struct DensifierConfig {
   double republish_threshold_rad = 1e-5;       // [rad] same for headings
   std::string parent_frame = "world";          // frame of the published poses
   std::string key_pose_channel = "KEY_POSES";  // key_poses_t from the backend
+  // [bytes] largest encoded dense_segments_t: under 64 KB, one UDP datagram's worth.
+  int max_message_bytes = 60000;
   template <class V>
   void visit(V& v) {
     v("mode", mode);
@@ -46,6 +48,7 @@ struct DensifierConfig {
     v("republish_threshold_rad", republish_threshold_rad);
     v("parent_frame", parent_frame);
     v("key_pose_channel", key_pose_channel);
+    v("max_message_bytes", max_message_bytes);
   }
 };
 
@@ -88,6 +91,9 @@ class Densifier {
   // Adds or re-optimises key poses (identified by utime). Returns the segments that were closed
   // for the first time or moved by more than the republish thresholds.
   std::vector<Segment> update_key_poses(const std::vector<KeyPose>& keys);
+  // End of data: every segment that differs at all from its last sent revision (moves below
+  // the republish thresholds add up to at most them), so the final trajectory is exact.
+  std::vector<Segment> settle();
 
   // Corrected pose at `utime`: bent inside closed segments, and moved rigidly with the nearest
   // key pose's correction before the first and after the last closed key pose.
@@ -112,7 +118,8 @@ class Densifier {
   // Dense poses with utime in [t0, t1], and the dense pose interpolated at both ends.
   std::vector<StampedPose> dense_between(int64_t t0, int64_t t1) const;
   // Recomputes the segment starting at key `it`; appends it to `out` if new or moved.
-  void refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out);
+  void refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out,
+                       bool exact = false);
   // Correction K D^-1 of a placed key pose.
   Pose2 correction(const KeyState& k) const;
 

@@ -1,9 +1,59 @@
 #include "densifier_node.hpp"
 
+#include <algorithm>
+
 #include "channels.hpp"
-#include "traverse/dense_segment_t.hpp"
 
 namespace traverse::densifier {
+
+namespace {
+
+dense_segment_t to_message(const Segment& s) {
+  dense_segment_t seg;
+  seg.key_id_first = s.key_id_first;
+  seg.key_id_last = s.key_id_last;
+  seg.revision = s.revision;
+  seg.n_poses = static_cast<int32_t>(s.poses.size());
+  for (const StampedPose& p : s.poses) {
+    seg.pose_utime.push_back(p.utime);
+    seg.x.push_back(p.T_world_base.x());
+    seg.y.push_back(p.T_world_base.y());
+    seg.theta.push_back(p.T_world_base.theta());
+  }
+  return seg;
+}
+
+}  // namespace
+
+std::vector<dense_segments_t> pack_segments(const std::vector<Segment>& segments,
+                                            const std::string& parent_frame,
+                                            const std::string& child_frame, int32_t optimisation,
+                                            int max_bytes) {
+  dense_segments_t empty{};
+  empty.parent_frame = parent_frame;
+  empty.child_frame = child_frame;
+  empty.optimisation = optimisation;
+  // Encoded size without segments (hash, fixed fields, both strings); each element adds its own.
+  const int header_bytes = empty.getEncodedSize();
+  std::vector<dense_segments_t> out;
+  int bytes = 0;
+  for (const Segment& s : segments) {
+    dense_segment_t seg = to_message(s);
+    const int seg_bytes = seg._getEncodedSizeNoHash();
+    if (out.empty() || (out.back().n_segments > 0 && bytes + seg_bytes > max_bytes)) {
+      out.push_back(empty);
+      bytes = header_bytes;
+    }
+    out.back().segments.push_back(std::move(seg));
+    ++out.back().n_segments;
+    bytes += seg_bytes;
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i].part = static_cast<int32_t>(i);
+    out[i].parts = static_cast<int32_t>(out.size());
+  }
+  return out;
+}
 
 DensifierNode::DensifierNode(Bus& bus, const DensifierConfig& config, CounterSink counters)
     : bus_(bus), config_(config), densifier_(config), counters_(std::move(counters)) {
@@ -19,35 +69,30 @@ void DensifierNode::on_frontend(const pose2d_t& msg) {
     ++dense_rejected_;
     return;
   }
+  newest_frontend_utime_ = std::max(newest_frontend_utime_, msg.utime);
   publish(closed);
 }
 
 void DensifierNode::on_key_poses(const key_poses_t& msg) {
+  optimisation_ = std::max(optimisation_, msg.optimisation);
   std::vector<KeyPose> keys;
   for (const key_pose_t& k : msg.poses) keys.push_back({k.id, k.utime, Pose2(k.x, k.y, k.theta)});
   publish(densifier_.update_key_poses(keys));
 }
 
 void DensifierNode::publish(const std::vector<Segment>& segments) {
+  if (segments.empty()) return;
+  for (dense_segments_t& msg : pack_segments(segments, config_.parent_frame, child_frame_,
+                                             optimisation_, config_.max_message_bytes)) {
+    msg.utime = newest_frontend_utime_;
+    if (msg.getEncodedSize() > config_.max_message_bytes) ++oversize_messages_;
+    bus_.publish(channels::kDenseSegments, msg);
+    ++segment_messages_;
+    segments_published_ += msg.n_segments;
+  }
+  // The growing trajectory: poses not sent before, in time order (a moved segment is only sent
+  // whole above).
   for (const Segment& s : segments) {
-    dense_segment_t seg;
-    seg.utime = s.poses.front().utime;
-    seg.parent_frame = config_.parent_frame;
-    seg.child_frame = child_frame_;
-    seg.key_id_first = s.key_id_first;
-    seg.key_id_last = s.key_id_last;
-    seg.revision = s.revision;
-    seg.n_poses = static_cast<int32_t>(s.poses.size());
-    for (const StampedPose& p : s.poses) {
-      seg.pose_utime.push_back(p.utime);
-      seg.x.push_back(p.T_world_base.x());
-      seg.y.push_back(p.T_world_base.y());
-      seg.theta.push_back(p.T_world_base.theta());
-    }
-    bus_.publish(channels::kDenseSegment, seg);
-    ++segments_published_;
-    // The growing trajectory: poses not sent before, in time order (a moved segment is only
-    // sent whole above).
     for (const StampedPose& p : s.poses) {
       if (p.utime <= last_dense_published_utime_) continue;
       pose2d_t out{};
@@ -63,11 +108,15 @@ void DensifierNode::publish(const std::vector<Segment>& segments) {
   }
 }
 
+void DensifierNode::finish() { publish(densifier_.settle()); }
+
 void DensifierNode::report_counters() {
   if (!counters_) return;
   counters_("dense_poses", static_cast<double>(densifier_.dense_size()));
   counters_("key_poses", static_cast<double>(densifier_.key_size()));
   counters_("segments_published", segments_published_);
+  counters_("segment_messages", segment_messages_);
+  counters_("oversize_messages", oversize_messages_);
   counters_("segments_moved", static_cast<double>(densifier_.segments_moved()));
   counters_("dense_rejected", dense_rejected_);
 }

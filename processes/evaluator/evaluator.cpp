@@ -10,6 +10,10 @@ std::optional<std::string> validate(const EvaluatorConfig& config) {
   }
   if (config.match.max_reference_gap_us <= 0) return "max_reference_gap_us: must be positive";
   if (config.match.edge_tolerance_us < 0) return "edge_tolerance_us: must not be negative";
+  if (!(config.false_closure_sigmas > 0.0) || !std::isfinite(config.false_closure_sigmas)) {
+    return "false_closure_sigmas: must be a positive number of standard deviations";
+  }
+  if (config.key_poses_channel.empty()) return "key_poses_channel: must not be empty";
   return std::nullopt;
 }
 

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "alignment.hpp"
+#include "final_trajectory.hpp"
+#include "loop_closures.hpp"
 #include "metrics.hpp"
 #include "trajectory.hpp"
 
@@ -19,12 +21,19 @@ namespace traverse::evaluator {
 struct EvaluatorConfig {
   std::string align = "first_pose";  // none | first_pose | se2 (see alignment.hpp)
   MatchConfig match;
+  // [standard deviations] a loop closure whose error against the reference has a Mahalanobis
+  // distance above this is false (loop_closures.hpp).
+  double false_closure_sigmas = 5.0;
+  // key_poses_t channel whose loop closures are checked (the backend's; absent without one).
+  std::string key_poses_channel = "KEY_POSES";
 
   template <class V>
   void visit(V& v) {
     v("align", align);
     v("max_reference_gap_us", match.max_reference_gap_us);
     v("edge_tolerance_us", match.edge_tolerance_us);
+    v("false_closure_sigmas", false_closure_sigmas);
+    v("key_poses_channel", key_poses_channel);
   }
 };
 

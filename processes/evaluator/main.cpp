@@ -1,6 +1,9 @@
 // traverse-evaluator: compares a trajectory channel with ground truth or reference poses, offline
-// on an LCM log (--log) or live in the graph (outputs written at SIGINT/SIGTERM). Writes
-// errors.csv and errors.png under --out and prints one JSON summary line last.
+// on an LCM log (--log) or live in the graph (outputs written at SIGINT/SIGTERM). The estimate
+// channel may carry pose2d_t, or the backend's key_poses_t or the densifier's dense_segments_t,
+// whose final (newest) revision is evaluated. The backend's loop closures are checked against the
+// reference. Writes errors.csv, errors.png and closures.csv under --out and prints one JSON
+// summary line last.
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -42,7 +45,8 @@ bool has_log_option(int argc, char** argv) {
 void add_options(CLI::App& app, Options& opt) {
   app.add_option("--log", opt.log, "evaluate this LCM log offline instead of listening live")
       ->check(CLI::ExistingFile);
-  app.add_option("--estimate", opt.estimate, "pose2d_t channel of the estimated trajectory")
+  app.add_option("--estimate", opt.estimate,
+                 "channel of the estimated trajectory: pose2d_t, key_poses_t or dense_segments_t")
       ->capture_default_str();
   app.add_option("--reference", opt.reference,
                  "pose2d_t channel of the reference (ground truth or reference poses)")
@@ -58,9 +62,16 @@ void add_options(CLI::App& app, Options& opt) {
 }
 
 // errors.csv and errors.png under --out, their paths (or why there is no plot) in the JSON.
-bool write_outputs(const Options& opt, const ev::Evaluation& evaluation, ev::JsonLine& json) {
+bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
+                   const ev::ClosureEvaluation& closures, ev::JsonLine& json) {
   std::error_code ec;
   fs::create_directories(opt.out, ec);
+  const std::string closures_csv = (fs::path(opt.out) / "closures.csv").string();
+  if (!ev::write_closures_csv(closures, closures_csv)) {
+    spdlog::error("traverse-evaluator: cannot write {}", closures_csv);
+    return false;
+  }
+  json.add("closures_csv", closures_csv);
   const std::string csv = (fs::path(opt.out) / "errors.csv").string();
   const std::string png = (fs::path(opt.out) / "errors.png").string();
   if (!ev::write_errors_csv(evaluation, csv)) {
@@ -89,6 +100,22 @@ bool write_outputs(const Options& opt, const ev::Evaluation& evaluation, ev::Jso
   return true;
 }
 
+// A channel carrying several types is an error of the graph, not of the figures: say so loudly.
+void report_type_problems(const ev::PoseCollector& collector, const std::string& estimate_channel) {
+  if (collector.mixed_type_messages() == 0) return;
+  std::string types;
+  for (const std::string& t : collector.estimate_types_seen()) {
+    types += (types.empty() ? "" : ", ") + t;
+  }
+  spdlog::error(
+      "traverse-evaluator: {} message(s) of an unexpected type dropped on the estimate or "
+      "reference channel (estimate channel {} carried {}; its type is taken as {})",
+      collector.mixed_type_messages(), estimate_channel, types.empty() ? "nothing" : types,
+      collector.estimate_type() == ev::EstimateType::kNone
+          ? "none"
+          : ev::estimate_type_name(collector.estimate_type()));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -108,7 +135,7 @@ int main(int argc, char** argv) {
     return traverse::kConfigErrorExitCode;
   }
 
-  ev::PoseCollector collector(opt.estimate, opt.reference);
+  ev::PoseCollector collector(opt.estimate, opt.reference, cfg.key_poses_channel);
   ev::PoseCollector::LogSummary log_summary;
   if (offline) {
     try {
@@ -120,8 +147,11 @@ int main(int argc, char** argv) {
   } else {
     collector.subscribe(proc.bus());
     const int rc = proc.spin([&] {
-      proc.counter("estimate_poses") = static_cast<double>(collector.estimate().size());
+      proc.counter("estimate_poses") = static_cast<double>(collector.estimate_size());
       proc.counter("reference_poses") = static_cast<double>(collector.reference().size());
+      proc.counter("loop_closures") = static_cast<double>(collector.closures().size());
+      proc.counter("decode_failures") = static_cast<double>(collector.decode_failures());
+      proc.counter("mixed_type_messages") = static_cast<double>(collector.mixed_type_messages());
     });
     if (rc != 0) return rc;
   }
@@ -129,16 +159,30 @@ int main(int argc, char** argv) {
   ev::Trajectory estimate = collector.estimate();
   if (opt.shift.size() == 3) ev::shift(estimate, opt.shift[0], opt.shift[1], opt.shift[2]);
   const ev::Evaluation evaluation = ev::evaluate(estimate, collector.reference(), cfg);
+  const ev::ClosureEvaluation closures = ev::check_closures(
+      collector.closures().closures(), collector.reference(), cfg.match, cfg.false_closure_sigmas);
+  report_type_problems(collector, opt.estimate);
 
   ev::JsonLine json;
   ev::add_evaluation(evaluation, json);
-  json.add("estimate_channel", opt.estimate)
-      .add("reference_channel", opt.reference)
-      .add_int("non_finite_poses", static_cast<long long>(collector.non_finite_poses()));
+  ev::add_closures(closures, json);
+  const std::string type = ev::estimate_type_name(collector.estimate_type());
+  json.add("estimate_channel", opt.estimate);
+  if (type.empty()) {
+    json.add_null("estimate_type");
+  } else {
+    json.add("estimate_type", type);
+  }
+  json.add("reference_channel", opt.reference)
+      .add("key_poses_channel", cfg.key_poses_channel)
+      .add_int("key_pose_revisions", static_cast<long long>(collector.key_poses().replaced()))
+      .add_int("dense_segments", static_cast<long long>(collector.dense().size()))
+      .add_int("non_finite_poses", static_cast<long long>(collector.non_finite_poses()))
+      .add_int("decode_failures", static_cast<long long>(collector.decode_failures()))
+      .add_int("mixed_type_messages", static_cast<long long>(collector.mixed_type_messages()));
   if (offline) {
     json.add("log", opt.log)
-        .add_int("log_damaged_records", static_cast<long long>(log_summary.damaged_records))
-        .add_int("decode_failures", static_cast<long long>(log_summary.decode_failures));
+        .add_int("log_damaged_records", static_cast<long long>(log_summary.damaged_records));
   }
   int rc = evaluation.matched > 0 ? 0 : 1;
   if (evaluation.matched == 0) {
@@ -146,7 +190,7 @@ int main(int argc, char** argv) {
         "traverse-evaluator: no estimate pose on {} matched a pose on {} ({} and {} poses)",
         opt.estimate, opt.reference, evaluation.estimate_poses, evaluation.reference_poses);
   }
-  if (!opt.out.empty() && !write_outputs(opt, evaluation, json)) return 1;
+  if (!opt.out.empty() && !write_outputs(opt, evaluation, closures, json)) return 1;
   std::cout << json.str() << std::endl;
   return rc;
 }

@@ -53,6 +53,30 @@ bool write_errors_csv(const Evaluation& ev, const std::string& path) {
   return static_cast<bool>(out.flush());
 }
 
+bool write_closures_csv(const ClosureEvaluation& ev, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) return false;
+  out << "from_id,to_id,from_utime_us,to_utime_us,matched,meas_x_m,meas_y_m,meas_theta_deg,"
+         "true_x_m,true_y_m,true_theta_deg,err_x_m,err_y_m,err_theta_deg,err_xy_m,sigma_x_m,"
+         "sigma_y_m,sigma_theta_deg,mahalanobis,false\n";
+  // Empty fields where there is no value (unmatched, or a covariance that is not positive
+  // definite), so that a reader never mistakes them for zero.
+  const auto num = [](bool have, double v) { return have ? fmt::format("{:.6f}", v) : ""; };
+  for (const ClosureCheck& c : ev.checks) {
+    const LoopClosure& l = c.closure;
+    const bool m = c.matched;
+    out << fmt::format(
+        "{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{}\n",
+        l.from_id, l.to_id, l.from_utime, l.to_utime, m ? 1 : 0, l.T_from_to.x(), l.T_from_to.y(),
+        kDegPerRad * l.T_from_to.theta(), num(m, c.T_true.x()), num(m, c.T_true.y()),
+        num(m, kDegPerRad * c.T_true.theta()), num(m, c.error.x()), num(m, c.error.y()),
+        num(m, kDegPerRad * c.error.z()), num(m, c.error.head<2>().norm()), c.sigma.x(),
+        c.sigma.y(), kDegPerRad * c.sigma.z(),
+        num(c.mahalanobis.has_value(), c.mahalanobis.value_or(0.0)), c.is_false ? 1 : 0);
+  }
+  return static_cast<bool>(out.flush());
+}
+
 std::optional<std::string> plot_errors(const std::string& script, const std::string& csv,
                                        const std::string& png, const std::string& title) {
   if (access(script.c_str(), R_OK) != 0) return "plot script not found: " + script;
@@ -136,6 +160,16 @@ void add_evaluation(const Evaluation& ev, JsonLine& json) {
       .add("align_x_m", ev.alignment.T_ref_est.x())
       .add("align_y_m", ev.alignment.T_ref_est.y())
       .add("align_theta_deg", kDegPerRad * ev.alignment.T_ref_est.theta());
+}
+
+void add_closures(const ClosureEvaluation& ev, JsonLine& json) {
+  json.add_int("loop_closures", static_cast<long long>(ev.closures))
+      .add_int("false_loop_closures", static_cast<long long>(ev.false_closures))
+      .add_int("loop_closures_unmatched", static_cast<long long>(ev.unmatched))
+      .add_int("loop_closures_bad_covariance", static_cast<long long>(ev.bad_covariance))
+      .add("loop_closure_max_mahalanobis", ev.max_mahalanobis, 3)
+      .add("loop_closure_max_error_m", ev.max_error_m)
+      .add("loop_closure_rms_error_m", ev.rms_error_m);
 }
 
 }  // namespace traverse::evaluator

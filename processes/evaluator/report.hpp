@@ -14,6 +14,10 @@ namespace traverse::evaluator {
 // Writes one row per matched estimate; false if the file cannot be written.
 bool write_errors_csv(const Evaluation& ev, const std::string& path);
 
+// Writes one row per loop closure (ids, times, measured and true relative pose, error, standard
+// deviations, Mahalanobis distance, false flag); false if the file cannot be written.
+bool write_closures_csv(const ClosureEvaluation& ev, const std::string& path);
+
 // Runs scripts/plot_errors.py CSV PNG TITLE with the first python3 that has matplotlib. Returns
 // nullopt on success, else why there is no plot. The script's output goes to stderr.
 std::optional<std::string> plot_errors(const std::string& script, const std::string& csv,
@@ -35,5 +39,8 @@ class JsonLine {
 
 // The figures of an evaluation under the keys scripts and later stages rely on.
 void add_evaluation(const Evaluation& ev, JsonLine& json);
+
+// The loop-closure figures: always present, counts 0 and figures null when there is no closure.
+void add_closures(const ClosureEvaluation& ev, JsonLine& json);
 
 }  // namespace traverse::evaluator

@@ -17,8 +17,8 @@ constexpr int64_t kImuStaleUs = 500'000;
 // Velocity estimates closer than this in time are averaged (exponentially) to tame the noise of
 // differencing poses a few milliseconds apart.
 constexpr double kVelocitySmoothingS = 0.1;
-// Scans further apart than this do not come from a scanner's stream (see predict()).
-constexpr int64_t kMaxStreamIntervalUs = 500'000;
+// Weight of the newest step in the average step of sparse scans (see update_motion()).
+constexpr double kSparseStepSmoothing = 0.3;
 
 Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
@@ -102,11 +102,12 @@ Pose2 Frontend::predict(int64_t utime, bool use_imu) const {
   // A scanner's stream: constant velocity over the elapsed time, but over at most twice the last
   // interval (after a pause it would predict an arbitrarily long step). Scans further apart than
   // any scanner's period are a log subsampled by travel (the CARMEN sets): their times say little
-  // about the motion, and repeating the last step predicts better.
+  // about the motion; the average of the last steps predicts better (see update_motion()).
   const int64_t elapsed = utime - last_utime_;
-  const int64_t horizon = last_interval_us_ > kMaxStreamIntervalUs
-                              ? last_interval_us_
-                              : std::min(elapsed, 2 * last_interval_us_);
+  if (elapsed > config_.matcher.wide_search_gap_us && have_sparse_step_ && !use_imu) {
+    return T_map_base_last_ * Pose2::exp(sparse_step_);
+  }
+  const int64_t horizon = std::min(elapsed, 2 * last_interval_us_);
   Eigen::Vector3d xi = velocity_ * (1e-6 * static_cast<double>(horizon));
   if (use_imu) xi.z() = yaw_.heading_change(last_utime_, utime);
   return T_map_base_last_ * Pose2::exp(xi);
@@ -157,6 +158,17 @@ void Frontend::update_motion(const Pose2& T_map_base, int64_t utime) {
     const double alpha = std::min(1.0, dt / kVelocitySmoothingS);
     velocity_ = alpha * v + (1.0 - alpha) * velocity_;
     last_interval_us_ = utime - last_utime_;
+    // Sparse scans: the step per scan, averaged over the last few. A log subsampled by travel
+    // moves about the same distance per scan, so the average keeps predicting forward motion
+    // where one step was underestimated (a corridor that does not show motion along its axis):
+    // repeating the last step would repeat the stall.
+    if (last_interval_us_ > config_.matcher.wide_search_gap_us) {
+      const Eigen::Vector3d step = between(T_map_base_last_, T_map_base).log();
+      constexpr double a = kSparseStepSmoothing;
+      sparse_step_ =
+          have_sparse_step_ ? Eigen::Vector3d(a * step + (1.0 - a) * sparse_step_) : step;
+      have_sparse_step_ = true;
+    }
   }
   T_map_base_last_ = T_map_base;
   last_utime_ = utime;
@@ -218,8 +230,10 @@ FrontendResult Frontend::process(const Scan& scan) {
         std::abs(between(T_pred, T_map_base_last_).theta()) > 0.01) {
       other_centres.push_back(T_map_base_last_);
     }
+    const bool sparse = scan.utime_last - last_utime_ > config_.matcher.wide_search_gap_us;
     const MatchResult m =
-        match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
+        sparse ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher)
+               : match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
     result.T_map_base = m.T_map_base;
     result.covariance = m.covariance;
     result.matched_points = m.points;

@@ -1,11 +1,13 @@
 // The frontend's per-scan pipeline (seed 000 section 2, Hector SLAM section IV):
 //   1. keep the valid readings of the scan (finite, inside the scanner's and the config's range);
 //   2. predict the pose at the scan's last point by constant velocity (heading change from the
-//      IMU when one is publishing);
+//      IMU when one is publishing); for sparse scans (more than matcher.wide_search_gap_us after
+//      the last pose: a log subsampled by travel) by the average step per scan;
 //   3. undo the motion during the sweep: every point is moved into the base frame at the scan's
 //      last point with the heading change at its own time (IMU yaw rate, or the constant
 //      angular velocity without IMU) and, optionally, the constant-velocity translation;
-//   4. match the points against the map pyramid, coarse to fine, from the prediction;
+//   4. match the points against the map pyramid, coarse to fine, from the prediction (sparse
+//      scans: from the best pose of a wide correlative search around it);
 //   5. update the map when the pose moved or turned past a threshold since the last update.
 // A scan with too few valid points gets the predicted pose (flagged); a scan whose time does not
 // advance, or whose last point is before its first, is dropped. Both are counted.
@@ -98,6 +100,9 @@ class Frontend {
   Pose2 T_map_base_last_;
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  // (vx [m/s], vy [m/s], omega [rad/s]) base
   Pose2 T_map_base_last_update_;
+  // Average step per scan (log of the relative pose, base frame) of sparse scans.
+  Eigen::Vector3d sparse_step_ = Eigen::Vector3d::Zero();
+  bool have_sparse_step_ = false;
   Eigen::Matrix3d covariance_last_ = Eigen::Matrix3d::Zero();
 
   // Reused between scans: beam directions of the last scan geometry, and point buffers.

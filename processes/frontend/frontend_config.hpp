@@ -54,6 +54,16 @@ struct MatcherConfig {
   double search_trigger_residual = 0.35;
   double search_linear_window_m = 1.0;     // +- in x and y
   double search_angular_window_rad = 0.8;  // +-
+  // Sparse scans: a scan more than wide_search_gap_us after the previous pose does not come from
+  // a scanner's stream but from a log subsampled by travel (the CARMEN sets: 0.5 to 1.8 m and up
+  // to 80 degrees between scans, no odometry). Constant velocity predicts such a step poorly, so
+  // it is always matched by a wide correlative search (branch and bound) around the prediction
+  // (the average step of the last scans) within the windows below, then Gauss-Newton from the
+  // best pose.
+  int64_t wide_search_gap_us = 500000;
+  double wide_search_linear_window_m = 2.0;     // +- in x and y
+  // +-; 80 degree turns between scans and a prediction 60 degrees off happen in the CARMEN sets.
+  double wide_search_angular_window_rad = 2.5;
 
   template <class V>
   void visit(V& v) {
@@ -69,6 +79,9 @@ struct MatcherConfig {
     v("search_trigger_residual", search_trigger_residual);
     v("search_linear_window_m", search_linear_window_m);
     v("search_angular_window_rad", search_angular_window_rad);
+    v("wide_search_gap_us", wide_search_gap_us);
+    v("wide_search_linear_window_m", wide_search_linear_window_m);
+    v("wide_search_angular_window_rad", wide_search_angular_window_rad);
   }
 };
 
@@ -145,6 +158,12 @@ inline std::optional<std::string> config_problem(const FrontendConfig& c) {
     return "matcher.max_range_m must exceed min_range_m";
   if (!(c.matcher.search_linear_window_m > 0.0 && c.matcher.search_angular_window_rad > 0.0))
     return "matcher.search_linear_window_m and search_angular_window_rad must be positive";
+  if (!(c.matcher.wide_search_linear_window_m > 0.0 &&
+        c.matcher.wide_search_angular_window_rad > 0.0 &&
+        c.matcher.wide_search_angular_window_rad <= 3.1416))
+    return "matcher.wide_search_linear_window_m must be positive and "
+           "wide_search_angular_window_rad in (0, pi]";
+  if (c.matcher.wide_search_gap_us <= 0) return "matcher.wide_search_gap_us must be positive";
   return std::nullopt;
 }
 

@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   traverse::Process proc("frontend",
                          "Hector-style scan-to-map matcher: one pose per scan with covariance");
   traverse::frontend::FrontendConfig config;
+  proc.offer_replay();
   if (auto rc = proc.start(argc, argv, config)) return *rc;
   if (auto problem = traverse::frontend::config_problem(config)) {
     spdlog::error("traverse-frontend: config error: {}: {}", proc.config_path(), *problem);

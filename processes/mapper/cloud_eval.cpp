@@ -64,19 +64,44 @@ std::optional<Eigen::Vector2d> fit_circle(const std::vector<Eigen::Vector2d>& pt
   return c;
 }
 
+std::string check_corridors(const std::vector<CorridorSpec>& corridors) {
+  for (const CorridorSpec& c : corridors) {
+    for (const WallProbe* w : {&c.end_a, &c.end_b}) {
+      const std::string where = "corridor " + c.name + (w == &c.end_a ? " end_a" : " end_b");
+      if (w->axis != "x" && w->axis != "y") return where + ": axis must be x or y";
+      if (w->across.empty()) return where + ": across needs at least one interval [lo, hi]";
+      for (const auto& iv : w->across) {
+        if (iv.size() != 2 || !(iv[0] < iv[1])) {
+          return where + ": every across interval must be [lo, hi] with lo < hi (metres)";
+        }
+      }
+    }
+  }
+  return {};
+}
+
 namespace {
 
+bool in_any(const std::vector<std::vector<double>>& intervals, double v) {
+  for (const auto& iv : intervals) {
+    if (v >= iv[0] && v <= iv[1]) return true;
+  }
+  return false;
+}
+
+// Median coordinate of the cloud points near the wall (nullopt below 20); `n` gets their number.
 std::optional<double> wall_position(const std::vector<CloudPoint>& cloud, const WallProbe& w,
-                                    const CloudEvalConfig& config) {
+                                    const CloudEvalConfig& config, int& n) {
   const int along = w.axis == "y" ? 1 : 0, other = 1 - along;
   std::vector<double> v;
   for (const CloudPoint& p : cloud) {
     const double a = p.p_world[along], o = p.p_world[other], z = p.p_world.z();
-    if (std::abs(a - w.at) < config.wall_band_m && o >= w.across[0] && o <= w.across[1] &&
-        z >= config.z_min_m && z <= config.z_max_m) {
+    if (std::abs(a - w.at) < config.wall_band_m && in_any(w.across, o) && z >= config.z_min_m &&
+        z <= config.z_max_m) {
       v.push_back(a);
     }
   }
+  n = static_cast<int>(v.size());
   if (v.size() < 20) return std::nullopt;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -108,8 +133,8 @@ CloudEvalResult evaluate_cloud(const std::vector<CloudPoint>& cloud, const sim::
     }
     PillarResult r{pillar.id, static_cast<int>(pts.size()), std::nullopt};
     if (r.points >= config.pillar_min_points) {
-      // Start from the centroid pushed back by the radius along the mean viewing side: a plain
-      // centroid of an arc lies inside the circle; the fit converges from either.
+      // Start from the centroid of the points: for the arc the scanner sees it lies inside the
+      // circle on the arc's side, nearer the true centre than the mirror solution behind the arc.
       Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
       for (const auto& q : pts) centroid += q;
       centroid /= static_cast<double>(pts.size());
@@ -123,9 +148,9 @@ CloudEvalResult evaluate_cloud(const std::vector<CloudPoint>& cloud, const sim::
   out.pillar = describe(std::move(errors), 0.0);
 
   for (const CorridorSpec& c : config.corridors) {
-    CorridorResult r{c.name, std::nullopt, std::abs(c.end_b.at - c.end_a.at)};
-    auto a = wall_position(cloud, c.end_a, config);
-    auto b = wall_position(cloud, c.end_b, config);
+    CorridorResult r{c.name, std::nullopt, std::abs(c.end_b.at - c.end_a.at), 0, 0};
+    auto a = wall_position(cloud, c.end_a, config, r.points_a);
+    auto b = wall_position(cloud, c.end_b, config, r.points_b);
     if (a && b) r.length_m = std::abs(*b - *a);
     out.corridors.push_back(r);
   }

@@ -21,11 +21,15 @@
 
 namespace traverse::mapper {
 
-// An end wall of a corridor: the plane x = at (axis "x") or y = at (axis "y"), seen through a box.
+// An end wall of a corridor: the plane x = at (axis "x") or y = at (axis "y"), seen through one or
+// more boxes. Several intervals let one end be taken where the scanner actually saw that plane:
+// the profile scanner reaches 6 m, and a corridor's own end may never come that close while the
+// same plane, continued into a neighbouring room, does.
 struct WallProbe {
   std::string axis = "x";
-  double at = 0.0;                      // [m] true position of the plane
-  std::vector<double> across = {0, 1};  // [m] range of the other horizontal coordinate
+  double at = 0.0;  // [m] true position of the plane
+  // [m] intervals [lo, hi] of the other horizontal coordinate where the plane is probed
+  std::vector<std::vector<double>> across = {{0, 1}};
   template <class V>
   void visit(V& v) {
     v("axis", axis);
@@ -83,7 +87,11 @@ struct CorridorResult {
   std::string name;
   std::optional<double> length_m;  // measured in the cloud
   double true_length_m = 0;
+  int points_a = 0, points_b = 0;  // cloud points near each end wall
 };
+
+// Empty if every probe of every corridor is valid; else what is wrong, naming the corridor.
+std::string check_corridors(const std::vector<CorridorSpec>& corridors);
 
 struct CloudEvalResult {
   Stats surface;  // point-to-surface distances [m]

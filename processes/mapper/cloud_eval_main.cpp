@@ -85,6 +85,10 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
     return traverse::kConfigErrorExitCode;
   }
+  if (const std::string bad = traverse::mapper::check_corridors(config.corridors); !bad.empty()) {
+    spdlog::error("{}: {}", config_file, bad);
+    return traverse::kConfigErrorExitCode;
+  }
   std::string error;
   auto cloud = traverse::mapper::read_ply(cloud_file, &error);
   if (!cloud) {
@@ -130,11 +134,12 @@ int main(int argc, char** argv) {
               r.pillar.n, 1e3 * r.pillar.mean, 1e3 * r.pillar.sd, 1e3 * r.pillar.rmse,
               1e3 * r.pillar.min, 1e3 * r.pillar.max);
   for (const auto& c : r.corridors) {
-    std::printf("corridor %s: %s m in the cloud, %.3f m true\n", c.name.c_str(),
-                opt(c.length_m).c_str(), c.true_length_m);
+    std::printf("corridor %s: %s m in the cloud, %.3f m true (%d and %d points at its ends)\n",
+                c.name.c_str(), opt(c.length_m).c_str(), c.true_length_m, c.points_a, c.points_b);
     corridors << (corridors.tellp() > 0 ? ", " : "") << "{\"name\": \"" << c.name
               << "\", \"length_m\": " << opt(c.length_m)
-              << ", \"true_length_m\": " << num(c.true_length_m)
+              << ", \"true_length_m\": " << num(c.true_length_m) << ", \"points_a\": " << c.points_a
+              << ", \"points_b\": " << c.points_b
               << ", \"error_m\": " << (c.length_m ? num(*c.length_m - c.true_length_m) : "null")
               << "}";
   }

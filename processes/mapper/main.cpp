@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   traverse::mapper::MapperConfig config;
   std::string out_dir;
   proc.cli().add_option("--out", out_dir, "export folder (overrides output_dir of the config)");
+  proc.offer_replay();
   if (auto rc = proc.start(argc, argv, config)) return *rc;
   if (!out_dir.empty()) config.output_dir = out_dir;
   traverse::sim::RigConfig rig;
@@ -38,9 +39,11 @@ int main(int argc, char** argv) {
     return traverse::kConfigErrorExitCode;
   }
   std::signal(SIGUSR1, on_usr1);
+  // Live, a worker thread does the mapping so that the socket is read while a loop closure's
+  // moves are applied; a replay works inline (it would otherwise queue the whole log).
   traverse::mapper::MapperNode node(
       proc.bus(), config, rig.laser_profile.transform(),
-      [&proc](const std::string& name, double v) { proc.counter(name) = v; });
+      [&proc](const std::string& name, double v) { proc.counter(name) = v; }, !proc.replaying());
   auto do_export = [&node, &config] {
     std::string error;
     if (node.export_all(&error)) {
@@ -51,7 +54,6 @@ int main(int argc, char** argv) {
     }
   };
   const int rc = proc.spin([&] {
-    node.tick();
     node.report_counters();
     if (g_export_requested.exchange(false)) do_export();
   });

@@ -56,7 +56,7 @@ struct MapperConfig {
   Footprint footprint;
   std::string rig_file = "configs/rig.yaml";  // laser_profile extrinsic T_base_laser
   std::string output_dir = "out/mapper";      // exports: cloud.ply, map.bt, map.ot
-  std::string pose_channel;     // "": DENSE_SEGMENT from the densifier; else pose2d_t stream
+  std::string pose_channel;     // "": DENSE_SEGMENTS from the densifier; else pose2d_t stream
   int poses_per_segment = 40;   // segment length when reading a pose2d_t stream
   double max_pending_s = 30.0;  // [s] profiles waiting longer for poses are dropped
   template <class V>

@@ -1,5 +1,6 @@
 #include "mapper_node.hpp"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "channels.hpp"
@@ -8,16 +9,26 @@
 namespace traverse::mapper {
 
 MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
-                       CounterSink counters)
+                       CounterSink counters, bool worker_thread)
     : config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
   bus.subscribe<planar_scan_t>(channels::kScanProfile,
                                [this](const planar_scan_t& m) { on_profile(m); });
   if (config_.pose_channel.empty()) {
-    bus.subscribe<dense_segment_t>(
-        channels::kDenseSegment, [this](const dense_segment_t& m) { on_segment(m); }, true);
+    bus.subscribe<dense_segments_t>(channels::kDenseSegments,
+                                    [this](const dense_segments_t& m) { on_segments(m); });
   } else {
     bus.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
   }
+  if (worker_thread) worker_ = std::thread([this] { run_worker(); });
+}
+
+MapperNode::~MapperNode() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  work_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
 }
 
 void MapperNode::on_profile(const planar_scan_t& msg) {
@@ -34,23 +45,33 @@ void MapperNode::on_profile(const planar_scan_t& msg) {
       p.intensities.push_back(static_cast<uint8_t>(static_cast<uint16_t>(v) >> 8));
     }
   }
-  latest_utime_ = std::max(latest_utime_, msg.utime_last);
-  if (!mapper_.add_profile(p)) ++rejected_;
+  submit(std::move(p));
+  message_done();
 }
 
-void MapperNode::on_segment(const dense_segment_t& msg) {
-  TrajectorySegment s;
-  s.key_id_first = msg.key_id_first;
-  s.utimes = msg.pose_utime;
-  for (int i = 0; i < msg.n_poses; ++i)
-    s.T_world_base.emplace_back(msg.x[i], msg.y[i], msg.theta[i]);
-  if (!mapper_.set_segment(s)) ++rejected_;
+void MapperNode::on_segments(const dense_segments_t& msg) {
+  for (const dense_segment_t& seg : msg.segments) {
+    auto known = revisions_.find(seg.key_id_first);
+    if (known != revisions_.end() && seg.revision <= known->second) {
+      ++segments_stale_;
+      continue;
+    }
+    revisions_[seg.key_id_first] = seg.revision;
+    TrajectorySegment s;
+    s.key_id_first = seg.key_id_first;
+    s.utimes = seg.pose_utime;
+    for (int i = 0; i < seg.n_poses; ++i)
+      s.T_world_base.emplace_back(seg.x[i], seg.y[i], seg.theta[i]);
+    submit(std::move(s));
+  }
+  message_done();
 }
 
 void MapperNode::on_pose(const pose2d_t& msg) {
   open_.utimes.push_back(msg.utime);
   open_.T_world_base.emplace_back(msg.x, msg.y, msg.theta);
   if (static_cast<int>(open_.utimes.size()) > config_.poses_per_segment) cut_segment();
+  message_done();
 }
 
 void MapperNode::cut_segment() {
@@ -59,21 +80,95 @@ void MapperNode::cut_segment() {
   TrajectorySegment next;
   next.utimes.push_back(open_.utimes.back());  // segments share their end pose
   next.T_world_base.push_back(open_.T_world_base.back());
-  if (!mapper_.set_segment(open_)) ++rejected_;
+  submit(std::move(open_));
   open_ = std::move(next);
 }
 
-void MapperNode::tick() {
+void MapperNode::submit(Work work) {
+  if (!worker_.joinable()) {
+    apply(work);
+    return;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(std::move(work));
+    ++submitted_;
+    max_queued_ = std::max(max_queued_, queue_.size());
+  }
+  work_cv_.notify_one();
+}
+
+void MapperNode::message_done() {
+  if (!worker_.joinable()) settle();  // inline: moves once per message, as the worker per batch
+}
+
+void MapperNode::apply(Work& work) {
+  if (auto* p = std::get_if<Profile>(&work)) {
+    latest_utime_ = std::max(latest_utime_, p->utime_last);
+    if (!mapper_.add_profile(*p)) ++rejected_;
+  } else if (mapper_.set_segment(std::get<TrajectorySegment>(work))) {
+    ++segments_applied_;
+  } else {
+    ++segments_rejected_;
+  }
+}
+
+void MapperNode::settle() {
   mapper_.apply_moves();
   dropped_ += static_cast<double>(mapper_.drop_stale(latest_utime_));
+  Snapshot s;
+  s.profiles = static_cast<double>(mapper_.profiles());
+  s.pending = static_cast<double>(mapper_.pending());
+  s.rejected = rejected_;
+  s.dropped = dropped_;
+  s.replaced = static_cast<double>(mapper_.profiles_replaced());
+  s.points = static_cast<double>(mapper_.points());
+  s.filtered = static_cast<double>(mapper_.points_filtered());
+  s.voxels = static_cast<double>(mapper_.occupied_voxels());
+  s.profile_bytes = static_cast<double>(mapper_.profile_bytes());
+  s.segments_applied = segments_applied_;
+  s.segments_rejected = segments_rejected_;
+  std::lock_guard lock(mutex_);
+  snapshot_ = s;
+}
+
+void MapperNode::run_worker() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    work_cv_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+    if (queue_.empty()) return;  // stopping with nothing left
+    // Everything queued so far, then the moves once: a loop closure arrives as many segments.
+    std::deque<Work> batch;
+    batch.swap(queue_);
+    lock.unlock();
+    for (Work& w : batch) apply(w);
+    settle();
+    lock.lock();
+    done_ += static_cast<int64_t>(batch.size());
+    idle_cv_.notify_all();
+  }
+}
+
+void MapperNode::flush() {
+  if (!worker_.joinable()) return;
+  std::unique_lock lock(mutex_);
+  idle_cv_.wait(lock, [this] { return done_ == submitted_; });
 }
 
 void MapperNode::finish() {
   if (!config_.pose_channel.empty()) cut_segment();
-  mapper_.apply_moves();
+  flush();
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  work_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  settle();
 }
 
 bool MapperNode::export_all(std::string* error) {
+  flush();  // the worker is idle now and stays so: this thread is the one that would queue more
   std::error_code ec;
   std::filesystem::create_directories(config_.output_dir, ec);
   const std::filesystem::path dir(config_.output_dir);
@@ -92,15 +187,28 @@ bool MapperNode::export_all(std::string* error) {
 
 void MapperNode::report_counters() {
   if (!counters_) return;
-  counters_("profiles", static_cast<double>(mapper_.profiles()));
-  counters_("profiles_pending", static_cast<double>(mapper_.pending()));
-  counters_("profiles_rejected", rejected_);
-  counters_("profiles_dropped", dropped_);
-  counters_("profiles_replaced", static_cast<double>(mapper_.profiles_replaced()));
-  counters_("points", static_cast<double>(mapper_.points()));
-  counters_("points_filtered", static_cast<double>(mapper_.points_filtered()));
-  counters_("occupied_voxels", static_cast<double>(mapper_.occupied_voxels()));
-  counters_("profile_memory_bytes", static_cast<double>(mapper_.profile_bytes()));
+  Snapshot s;
+  double queued = 0, max_queued = 0;
+  {
+    std::lock_guard lock(mutex_);
+    s = snapshot_;
+    queued = static_cast<double>(queue_.size());
+    max_queued = static_cast<double>(max_queued_);
+  }
+  counters_("profiles", s.profiles);
+  counters_("profiles_pending", s.pending);
+  counters_("profiles_rejected", s.rejected);
+  counters_("profiles_dropped", s.dropped);
+  counters_("profiles_replaced", s.replaced);
+  counters_("points", s.points);
+  counters_("points_filtered", s.filtered);
+  counters_("occupied_voxels", s.voxels);
+  counters_("profile_memory_bytes", s.profile_bytes);
+  counters_("segments_applied", s.segments_applied);
+  counters_("segments_stale", segments_stale_);
+  counters_("segments_rejected", s.segments_rejected);
+  counters_("work_queued", queued);
+  counters_("work_queued_max", max_queued);
 }
 
 }  // namespace traverse::mapper

@@ -1,18 +1,32 @@
 // Adapts LCM messages to the Mapper: tilted profiles (planar_scan_t on SCAN_PROFILE) and the
 // corrected trajectory in, exports out. The trajectory comes either as whole segments from the
-// densifier (dense_segment_t on DENSE_SEGMENT; a moved segment arrives again with an earlier
-// utime, so that channel accepts out-of-order messages) or, with `pose_channel` set, as a plain
+// densifier (dense_segments_t on DENSE_SEGMENTS, many segments per message; a moved segment
+// arrives again with a higher revision, and only the newest revision of each segment is kept, so
+// a revision that arrives late cannot undo a newer one) or, with `pose_channel` set, as a plain
 // pose2d_t stream (e.g. POSE_GROUND_TRUTH) cut into segments of `poses_per_segment` poses that
 // never move.
+//
+// Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
+// after a loop closure the mapper re-places thousands of profiles (tens of seconds of work on a
+// whole route), and a process that stops reading its socket for that long loses every datagram
+// that overflows the receive buffer (on office-s2 a third of the profiles and segment messages).
+// The queue keeps the order of arrival, so the result is the same as handling each message at
+// once; offline (--replay) the node works inline instead, which keeps memory bounded.
 #pragma once
 
+#include <condition_variable>
+#include <deque>
 #include <functional>
+#include <map>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <variant>
 #include <vector>
 
 #include "bus.hpp"
 #include "mapper.hpp"
-#include "traverse/dense_segment_t.hpp"
+#include "traverse/dense_segments_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
 
@@ -21,31 +35,64 @@ namespace traverse::mapper {
 class MapperNode {
  public:
   using CounterSink = std::function<void(const std::string& name, double value)>;
+  // `worker_thread`: run the Mapper on its own thread (live); false: inline in the handlers.
   MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
-             CounterSink counters = {});
+             CounterSink counters = {}, bool worker_thread = true);
+  ~MapperNode();
+  MapperNode(const MapperNode&) = delete;
+  MapperNode& operator=(const MapperNode&) = delete;
 
-  // Applies pending moves and drops profiles that waited too long (call from the loop).
-  void tick();
-  // Writes cloud.ply, map.bt and map.ot into the output folder; false (and why) on failure.
+  // Waits until everything received so far is in the map (moves applied).
+  void flush();
+  // Writes cloud.ply, map.bt and map.ot into the output folder (after a flush); false (and why)
+  // on failure.
   bool export_all(std::string* error);
-  // At shutdown: closes the last segment of a pose2d_t stream, applies moves.
+  // At shutdown: closes the last segment of a pose2d_t stream, applies everything, stops the
+  // worker.
   void finish();
   void report_counters();
+  // The map; read it only after flush() or finish() and before the next message is handled.
   const Mapper& mapper() const { return mapper_; }
 
  private:
+  using Work = std::variant<Profile, TrajectorySegment>;
+  // Counters the worker publishes for the main thread.
+  struct Snapshot {
+    double profiles = 0, pending = 0, rejected = 0, dropped = 0, replaced = 0, points = 0,
+           filtered = 0, voxels = 0, profile_bytes = 0, segments_applied = 0, segments_rejected = 0;
+  };
+
   void on_profile(const planar_scan_t& msg);
-  void on_segment(const dense_segment_t& msg);
+  void on_segments(const dense_segments_t& msg);
   void on_pose(const pose2d_t& msg);
   void cut_segment();
 
+  void submit(Work work);
+  void message_done();     // after each message's submits
+  void apply(Work& work);  // worker side
+  void settle();           // worker side: applies moves, drops stale profiles, takes a snapshot
+  void run_worker();
+
   MapperConfig config_;
-  Mapper mapper_;
+  Mapper mapper_;  // touched only by the worker (or inline)
   CounterSink counters_;
-  int64_t latest_utime_ = 0;
-  double rejected_ = 0, dropped_ = 0;
+  // Handler side (LCM thread).
+  std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first
+  double segments_stale_ = 0;
   TrajectorySegment open_;  // pose2d_t stream: poses since the last cut
   int64_t next_key_id_ = 0;
+  // Worker side.
+  int64_t latest_utime_ = 0;  // [us] newest profile time applied
+  double rejected_ = 0, dropped_ = 0, segments_applied_ = 0, segments_rejected_ = 0;
+  // Between both.
+  std::mutex mutex_;
+  std::condition_variable work_cv_, idle_cv_;
+  std::deque<Work> queue_;
+  int64_t submitted_ = 0, done_ = 0;
+  std::size_t max_queued_ = 0;
+  bool stop_ = false;
+  Snapshot snapshot_;
+  std::thread worker_;
 };
 
 }  // namespace traverse::mapper

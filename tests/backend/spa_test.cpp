@@ -75,6 +75,39 @@ TEST(Spa, ReusesSymbolicAnalysisWhileThePatternIsUnchanged) {
   EXPECT_EQ(optimizer.system().analyses(), 2);
 }
 
+TEST(Spa, AGrowingChainKeepsTheOrderingAndALoopOrdersAfresh) {
+  PoseGraph g = testing::make_walk_graph(60, 0);
+  SpaOptimizer optimizer;
+  optimizer.optimize(g);
+  EXPECT_EQ(optimizer.system().orderings_reused(), 0);
+  // Key poses appended one by one, each linked to the newest: the ordering is extended.
+  for (int k = 0; k < 10; ++k) {
+    const int n = static_cast<int>(g.poses.size());
+    const Pose2 step(0.5, 0.0, 0.05);
+    g.add_vertex(n, g.poses.back() * step);
+    g.edges.push_back({n - 1, n, step, Eigen::Matrix3d::Identity() * 100.0});
+    const SpaResult r = optimizer.optimize(g);
+    EXPECT_TRUE(r.converged);
+  }
+  EXPECT_EQ(optimizer.system().analyses(), 11);
+  EXPECT_EQ(optimizer.system().orderings_reused(), 10);
+  // A new vertex closing a loop to an old one is ordered afresh, and the answer is the same as
+  // a fresh optimiser's.
+  const int n = static_cast<int>(g.poses.size());
+  g.add_vertex(n, g.poses.back() * Pose2(0.5, 0.0, 0.0));
+  g.edges.push_back({n - 1, n, Pose2(0.5, 0.0, 0.0), Eigen::Matrix3d::Identity() * 100.0});
+  g.edges.push_back({3, n, between(g.poses[3], g.poses[n]) * Pose2(0.05, 0.0, 0.0),
+                     Eigen::Matrix3d::Identity() * 100.0});
+  PoseGraph h = g;
+  optimizer.optimize(g);
+  EXPECT_EQ(optimizer.system().orderings_reused(), 10);
+  SpaOptimizer fresh;
+  fresh.optimize(h);
+  for (int i = 0; i <= n; ++i) {
+    EXPECT_NEAR((g.poses[i].translation() - h.poses[i].translation()).norm(), 0.0, 1e-9) << i;
+  }
+}
+
 TEST(Spa, NonFiniteCostKeepsThePreviousState) {
   // A degenerate measurement (NaN information, as a failed matcher might produce) added to an
   // optimised graph: the optimiser reports it and leaves the poses untouched.

@@ -69,6 +69,41 @@ TEST(JumpSmoothing, ReplacesAHeadingJump) {
   EXPECT_EQ(smooth_jumps(poses, {}).replaced_steps, std::vector<int>{60});
 }
 
+TEST(JumpSmoothing, ReplacesAnOutlierWithoutMovingWhatFollows) {
+  // At 0.35 m/s one pose sits 12 mm to the side and the next is back on the path (a bad match
+  // seen on the simulated office): only that pose changes.
+  std::vector<StampedPose> poses = drive(100, 0.35, 0.0);
+  const std::vector<StampedPose> clean = poses;
+  poses[50].T_world_base = poses[50].T_world_base * Pose2(0.004, -0.012, 0.0);
+  const SmoothedTrajectory s = smooth_jumps(poses, {});
+  EXPECT_TRUE(s.replaced_steps.empty());
+  ASSERT_EQ(s.outliers, std::vector<int>{50});
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(
+        (s.poses[k].T_world_base.translation() - clean[k].T_world_base.translation()).norm(), 0.0,
+        1e-9)
+        << k;
+  }
+}
+
+TEST(JumpSmoothing, DeviationsBelowTheMinimumAreNotJumps) {
+  // 4 mm sideways at 0.2 m/s (5 mm per scan) turns the step by 0.67 rad: matching noise, not a
+  // jump, unless the minimum and the direction limit are set tighter.
+  std::vector<StampedPose> poses = drive(100, 0.2, 0.0);
+  for (std::size_t k = 50; k < poses.size(); ++k) {
+    poses[k].T_world_base = Pose2(0.0, 0.004, 0.0) * poses[k].T_world_base;
+  }
+  const SmoothedTrajectory s = smooth_jumps(poses, {});
+  EXPECT_TRUE(s.replaced_steps.empty());
+  EXPECT_TRUE(s.outliers.empty());
+  JumpSmoothingConfig strict;
+  strict.min_jump_m = 0.001;
+  strict.max_direction_change_rad = 0.5;
+  const SmoothedTrajectory t = smooth_jumps(poses, strict);
+  EXPECT_EQ(t.replaced_steps, std::vector<int>{50});
+  EXPECT_TRUE(t.outliers.empty());
+}
+
 TEST(KeyPoses, ThreePerSecondByTime) {
   const std::vector<StampedPose> poses = drive(121, 1.0, 0.0);  // 3 s at 40 Hz
   const std::vector<int> keys = select_key_poses(poses, {});

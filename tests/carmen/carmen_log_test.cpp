@@ -196,6 +196,77 @@ TEST(Reader, TimeNeverGoesBackwards) {
   std::filesystem::remove(path);
 }
 
+TEST(PrintedQuantum, IsThePlaceValueOfTheLastDigit) {
+  EXPECT_DOUBLE_EQ(printed_quantum("1.13486e+09"), 1e4);
+  EXPECT_DOUBLE_EQ(printed_quantum("32.9068"), 1e-4);
+  EXPECT_DOUBLE_EQ(printed_quantum("1134863808.25"), 1e-2);
+  EXPECT_DOUBLE_EQ(printed_quantum("7"), 1.0);
+  EXPECT_DOUBLE_EQ(printed_quantum("1.5E3"), 100.0);
+  EXPECT_DOUBLE_EQ(printed_quantum("2.5e-3"), 1e-4);
+}
+
+// Timestamps printed with 6 significant digits (csail): all scans share one value. They are
+// spaced at the nominal period, or stamped by the logger's clock when that is printed finely.
+TEST(Reader, QuantisedTimestampsAreSpaced) {
+  const auto path = temp_file("quantised.log");
+  std::ofstream(path) << flaser_line(2, "1.13486e+09") << "\n"
+                      << flaser_line(2, "1.13486e+09") << "\n"
+                      << flaser_line(2, "1.13486e+09") << "\n"
+                      << flaser_line(2, "1.13487e+09") << "\n";
+  Reader reader(path.string(), FlaserGeometry::kStandard, {1.0, 2.5});
+  std::vector<int64_t> utimes;
+  while (auto scan = reader.next()) utimes.push_back(scan->utime);
+  const int64_t t0 = 1'134'860'000'000'000;
+  EXPECT_EQ(utimes, (std::vector<int64_t>{t0, t0 + 2'500'000, t0 + 5'000'000, t0 + 7'500'000}));
+  EXPECT_EQ(reader.summary().quantised_count, 4);
+  EXPECT_EQ(reader.summary().restamped_nominal, 3);  // the first keeps its (coarse) time
+  EXPECT_EQ(reader.summary().restamped_logger, 0);
+  EXPECT_EQ(reader.summary().backwards_count, 0);
+  EXPECT_DOUBLE_EQ(reader.summary().max_quantum_s, 1e4);
+  std::filesystem::remove(path);
+
+  // A fine logger timestamp (the line's last field) is used instead.
+  auto with_logger = [](const std::string& logger) {
+    std::string line = flaser_line(2, "1.13486e+09");
+    return line.substr(0, line.rfind(' ') + 1) + logger;
+  };
+  std::ofstream(path) << with_logger("1134860000.5") << "\n"
+                      << with_logger("1134860003.25") << "\n";
+  Reader logged(path.string());
+  utimes.clear();
+  while (auto scan = logged.next()) utimes.push_back(scan->utime);
+  EXPECT_EQ(utimes, (std::vector<int64_t>{1'134'860'000'500'000, 1'134'860'003'250'000}));
+  EXPECT_EQ(logged.summary().restamped_logger, 2);
+  EXPECT_EQ(logged.summary().restamped_nominal, 0);
+  std::filesystem::remove(path);
+}
+
+TEST(Reader, FineTimestampsAreKept) {
+  const auto path = temp_file("fine.log");
+  std::ofstream(path) << flaser_line(2, "32.9068") << "\n" << flaser_line(2, "35.1051") << "\n";
+  Reader reader(path.string());
+  std::vector<int64_t> utimes;
+  while (auto scan = reader.next()) utimes.push_back(scan->utime);
+  EXPECT_EQ(utimes, (std::vector<int64_t>{32'906'800, 35'105'100}));
+  EXPECT_EQ(reader.summary().quantised_count, 0);
+  std::filesystem::remove(path);
+}
+
+// The real csail log: 406 scans within two printed values; spaced, every scan has its own time.
+TEST(Reader, CsailScansGetDistinctSpacedTimes) {
+  const std::string path = "../shared/data/carmen/csail-corrected.log.gz";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no data at " << path;
+  Reader reader(path);
+  std::vector<int64_t> utimes;
+  while (auto scan = reader.next()) utimes.push_back(scan->utime);
+  ASSERT_GT(utimes.size(), 400u);
+  for (std::size_t i = 1; i < utimes.size(); ++i) {
+    ASSERT_GE(utimes[i] - utimes[i - 1], 1'000'000) << "scan " << i;
+  }
+  EXPECT_EQ(reader.summary().quantised_count, static_cast<int64_t>(utimes.size()));
+  EXPECT_EQ(reader.summary().backwards_count, 0);
+}
+
 TEST(Reader, AHugeLineIsMalformedAndReadingGoesOn) {
   const auto path = temp_file("huge.log");
   {

@@ -137,5 +137,24 @@ TEST(Densifier, IncrementalSegmentsAndReoptimisation) {
   EXPECT_EQ(d.corrected_trajectory().size(), 71u);
 }
 
+TEST(Densifier, MovesBelowTheThresholdWaitUntilTheEnd) {
+  DensifierConfig config;
+  config.republish_threshold_m = 0.001;
+  Densifier d(config);
+  std::vector<Segment> closed;
+  for (int i = 0; i <= 40; ++i) d.add_dense(kT0 + i * kDt, Pose2(0.005 * i, 0, 0), &closed);
+  std::vector<KeyPose> keys;
+  for (int k = 0; k < 3; ++k) keys.push_back({k, kT0 + 20 * k * kDt, Pose2(0.1 * k, 0.0, 0)});
+  ASSERT_EQ(d.update_key_poses(keys).size(), 2u);
+  // 0.6 mm: below the threshold, not sent; nothing else moved, so settling sends just that.
+  keys[2].T_world_base = Pose2(0.2, 0.0006, 0);
+  EXPECT_TRUE(d.update_key_poses({keys[2]}).empty());
+  const std::vector<Segment> settled = d.settle();
+  ASSERT_EQ(settled.size(), 1u);
+  EXPECT_EQ(settled[0].key_id_first, 1);
+  EXPECT_NEAR(settled[0].poses.back().T_world_base.y(), 0.0006, 1e-12);
+  EXPECT_TRUE(d.settle().empty());  // once settled, nothing is left to send
+}
+
 }  // namespace
 }  // namespace traverse::densifier

@@ -1,12 +1,15 @@
-// The frontend on a real CARMEN log (SICK, 360 beams, no IMU), compared with the log's corrected
-// reference trajectory: relative pose error over 1 m and 10 m of travel, and the largest jump
-// (step of the estimate beyond the reference's step).
+// The frontend on the four real CARMEN logs (SICK, 180 beams, no odometry, no IMU), configured by
+// configs/frontend.yaml, compared with each log's corrected reference trajectory: relative pose
+// error over 1 m and 10 m of travel, and the largest jump (step of the estimate beyond the
+// reference's step), the same figures traverse-evaluator reports (rpe_1m_m, rpe_10m_m, max_jump_m).
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "carmen_log.hpp"
+#include "config.hpp"
 #include "frontend.hpp"
 
 namespace traverse::frontend {
@@ -15,6 +18,7 @@ namespace {
 struct Metrics {
   int scans = 0;
   int predicted = 0;
+  int searched = 0;
   double rpe_1m_m = 0.0, rpe_10m_m = 0.0, max_jump_m = 0.0;
 };
 
@@ -30,9 +34,9 @@ double relative_pose_error(const std::vector<Pose2>& ref, const std::vector<Pose
   int n = 0;
   std::size_t j = 0;
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    j = std::max(j, i);
+    j = std::max(j, i + 1);
     while (j < ref.size() && travelled[j] - travelled[i] < distance_m) ++j;
-    if (j == ref.size()) break;
+    if (j >= ref.size()) break;
     const Eigen::Vector2d e =
         between(ref[i], ref[j]).translation() - between(est[i], est[j]).translation();
     sum += e.squaredNorm();
@@ -45,6 +49,7 @@ Metrics run_log(const std::string& path) {
   carmen::Reader reader(path);
   EXPECT_TRUE(reader.good()) << path;
   FrontendConfig config;
+  load_config("configs/frontend.yaml", config);
   Frontend frontend(config);
   std::vector<Pose2> ref, est;
   Metrics m;
@@ -53,14 +58,24 @@ Metrics run_log(const std::string& path) {
     scan.utime_first = scan.utime_last = s->utime;
     scan.angle_first = s->beams.angle_first;
     scan.angle_step = s->beams.angle_step;
-    scan.range_min = 0.0;
-    scan.range_max = s->range_max_m.value_or(40.0);
+    // As the driver publishes them (configs/carmen.yaml defaults): no-return markers are 50 m+.
+    scan.range_min = 0.05;
+    scan.range_max = 49.9;
     scan.ranges = s->ranges;
     const FrontendResult r = frontend.process(scan);
     if (r.status == ScanStatus::kDropped) continue;
     if (r.status == ScanStatus::kPredicted) ++m.predicted;
+    if (r.searched) ++m.searched;
     ref.emplace_back(s->x_m, s->y_m, s->theta_rad);
     est.push_back(r.T_map_base);
+    // CARMEN_TRACE=1: every step, reference against estimate, to find where tracking fails.
+    if (std::getenv("CARMEN_TRACE") && ref.size() > 1) {
+      const std::size_t i = ref.size() - 1;
+      const Pose2 dr = between(ref[i - 1], ref[i]), de = between(est[i - 1], est[i]);
+      std::printf("TRACE %zu ref %.3f %.3f %.1f est %.3f %.3f %.1f err %.3f res %.3f\n", i, dr.x(),
+                  dr.y(), dr.theta() * 57.3, de.x(), de.y(), de.theta() * 57.3,
+                  (dr.translation() - de.translation()).norm(), r.residual_rms);
+    }
   }
   m.scans = static_cast<int>(est.size());
   for (std::size_t i = 1; i < est.size(); ++i) {
@@ -73,22 +88,47 @@ Metrics run_log(const std::string& path) {
   return m;
 }
 
-// Freiburg 079 is the log within the frontend's regime (a scan every 0.1 m of travel, at most
-// 0.3 rad of turn). The other three logs (a scan per metre, turns up to 78 degrees between scans)
-// are far outside what scan-to-map Gauss-Newton is built for; scripts/eval-carmen.sh reports them.
-TEST(CarmenLog, Freiburg079TracksReference) {
-  const std::string path = "../shared/data/carmen/freiburg-079-corrected.log.gz";
+struct LogCase {
+  const char* name;
+  friend void PrintTo(const LogCase& c, std::ostream* os) { *os << c.name; }
+  int min_scans;
+  double max_rpe_1m_m, max_rpe_10m_m, max_jump_m;
+};
+
+class CarmenLog : public ::testing::TestWithParam<LogCase> {};
+
+TEST_P(CarmenLog, TracksReference) {
+  const LogCase& c = GetParam();
+  const std::string path = std::string("../shared/data/carmen/") + c.name + "-corrected.log.gz";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no data at " << path;
   const Metrics m = run_log(path);
   std::printf(
-      "freiburg-079: %d scans, %d predicted, rpe_1m %.4f m, rpe_10m %.4f m, max_jump %.4f m\n",
-      m.scans, m.predicted, m.rpe_1m_m, m.rpe_10m_m, m.max_jump_m);
-  EXPECT_GT(m.scans, 4700);
+      "%s: %d scans, %d predicted, %d searched, rpe_1m %.4f m, rpe_10m %.4f m, max_jump %.4f m\n",
+      c.name, m.scans, m.predicted, m.searched, m.rpe_1m_m, m.rpe_10m_m, m.max_jump_m);
+  EXPECT_GT(m.scans, c.min_scans);
   EXPECT_EQ(m.predicted, 0);
-  EXPECT_LT(m.rpe_1m_m, 0.1);
-  EXPECT_LT(m.rpe_10m_m, 0.25);
-  EXPECT_LT(m.max_jump_m, 1.0);
+  EXPECT_LT(m.rpe_1m_m, c.max_rpe_1m_m);
+  EXPECT_LT(m.rpe_10m_m, c.max_rpe_10m_m);
+  EXPECT_LT(m.max_jump_m, c.max_jump_m);
 }
+
+// Bounds a little above what the frontend reaches (measured, configs/frontend.yaml; rpe_1m /
+// rpe_10m / max_jump): freiburg-079 0.051 / 0.103 / 0.74 m, intel 0.104 / 0.118 / 0.67 m, aces
+// 0.092 / 0.260 / 0.81 m, csail 0.056 / 0.144 / 0.41 m. Issue 4 asks for max_jump under 0.5 m
+// on all four: not reached yet on freiburg-079, intel and aces (a few single mis-matched scans);
+// these bounds guard what is reached. Before the wide search for sparse scans, intel, aces and
+// csail lost track (rpe_10m 2.97 / 4.31 / 4.18 m).
+INSTANTIATE_TEST_SUITE_P(Logs, CarmenLog,
+                         ::testing::Values(LogCase{"freiburg-079", 4700, 0.1, 0.25, 1.0},
+                                           LogCase{"intel", 900, 0.15, 0.2, 1.0},
+                                           LogCase{"aces", 430, 0.15, 0.4, 1.0},
+                                           LogCase{"csail", 400, 0.1, 0.25, 0.5}),
+                         [](const auto& info) {
+                           std::string n = info.param.name;
+                           for (char& ch : n)
+                             if (ch == '-') ch = '_';
+                           return n;
+                         });
 
 }  // namespace
 }  // namespace traverse::frontend

@@ -38,6 +38,27 @@ TEST_P(MatcherLevel, RecoversKnownOffsetOnLevel) {
 
 INSTANTIATE_TEST_SUITE_P(Levels, MatcherLevel, ::testing::Values(0, 1, 2));
 
+// A sparse scan (180 beams over the front 180 degrees) 1.4 m and 70 degrees from the prediction:
+// the wide search's branch and bound finds it on level 1, and Gauss-Newton refines it.
+TEST(ScanMatcher, WideSearchFindsSparseScanFarFromPrediction) {
+  const auto world = synthetic::room();
+  const MapPyramid maps = build_map(world, {kMapPose, Pose2(-1.5, 1.0, 0.0)});
+  const Pose2 truth(0.5, 0.4, 0.3);
+  std::vector<Eigen::Vector2d> points;
+  for (const auto& p : static_scan(world, truth, 360, 0.005)) {
+    if (p.x() > 0.0) points.push_back(p);  // the front half, one point per degree
+  }
+  const Pose2 start(truth.x() - 1.0, truth.y() + 1.0, truth.theta() - 1.22);
+  const WideSearchResult s = wide_search(maps.level(1), points, start, 2.0, 1.5);
+  EXPECT_LT((s.T_map_base.translation() - truth.translation()).norm(), 0.1);
+  EXPECT_LT(std::abs(wrap_angle(s.T_map_base.theta() - truth.theta())), 0.02);
+  EXPECT_GT(s.score, 0.5);
+  const MatchResult r = match_scan_wide(maps, points, {start}, MatcherConfig{});
+  EXPECT_TRUE(r.searched);
+  EXPECT_LT((r.T_map_base.translation() - truth.translation()).norm(), 0.01);
+  EXPECT_LT(std::abs(wrap_angle(r.T_map_base.theta() - truth.theta())), 0.003);
+}
+
 // The whole pyramid, coarse to fine, converges from further away than any single fine level.
 TEST(ScanMatcher, PyramidConvergesFromLargeOffset) {
   const auto world = synthetic::room();

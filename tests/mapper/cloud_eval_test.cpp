@@ -1,5 +1,6 @@
 // Cloud evaluation on a tiny true world: a shifted cloud gives the shift back as point-to-surface
-// distance, pillar centre error and corridor length error.
+// distance, pillar centre error and corridor length error; end walls are probed only inside their
+// intervals.
 #include "cloud_eval.hpp"
 
 #include <gtest/gtest.h>
@@ -54,7 +55,7 @@ TEST(CloudEval, ShiftedCloudGivesTheShiftBack) {
   const sim::WorldSpec spec = tiny_world();
   const sim::World world(spec);
   CloudEvalConfig config;
-  config.corridors = {{"main", {"x", 0.0, {-1.5, 1.5}}, {"x", 10.0, {-1.5, 1.5}}}};
+  config.corridors = {{"main", {"x", 0.0, {{-1.5, 1.5}}}, {"x", 10.0, {{-1.5, -0.5}, {0.5, 1.5}}}}};
   const auto exact = evaluate_cloud(cloud(Eigen::Vector3f::Zero()), world, spec, config);
   EXPECT_LT(exact.surface.rmse, 1e-5);
   ASSERT_EQ(exact.pillar.n, 1);
@@ -67,6 +68,49 @@ TEST(CloudEval, ShiftedCloudGivesTheShiftBack) {
   EXPECT_NEAR(shifted.pillar.max, 0.004, 2e-5);
   EXPECT_NEAR(shifted.surface.p95, 0.004, 5e-4);
   EXPECT_NEAR(*shifted.corridors[0].length_m, 10.0, 1e-5);
+}
+
+// An end wall probed in two intervals: points between them (a shelf standing 5 cm in front of the
+// wall) are left out, and the points counted are exactly those inside the intervals.
+TEST(CloudEval, EndWallIsProbedOnlyInsideItsIntervals) {
+  const sim::WorldSpec spec = tiny_world();
+  const sim::World world(spec);
+  std::vector<CloudPoint> pts = cloud(Eigen::Vector3f::Zero());
+  int expected_b = 0;
+  for (const CloudPoint& p : pts) {
+    const float y = p.p_world.y();
+    if (p.p_world.x() == 10.0f && ((y >= -1.5f && y <= -0.5f) || (y >= 0.5f && y <= 1.5f))) {
+      ++expected_b;
+    }
+  }
+  for (int i = 0; i < 2000; ++i) {  // the shelf face: many points, all 5 cm off the wall
+    pts.push_back(
+        {Eigen::Vector3f(9.95f, -0.4f + 0.8f * static_cast<float>(i) / 2000.0f, 1.0f), 0, 0, 0});
+  }
+  CloudEvalConfig config;
+  config.corridors = {{"main", {"x", 0.0, {{-1.5, 1.5}}}, {"x", 10.0, {{-1.5, -0.5}, {0.5, 1.5}}}}};
+  const auto r = evaluate_cloud(pts, world, spec, config, 1);
+  ASSERT_TRUE(r.corridors[0].length_m);
+  EXPECT_NEAR(*r.corridors[0].length_m, 10.0, 1e-5);
+  EXPECT_EQ(r.corridors[0].points_b, expected_b);
+  // One interval over the whole wall takes the shelf in: its median moves off the wall.
+  config.corridors[0].end_b.across = {{-1.5, 1.5}};
+  const auto biased = evaluate_cloud(pts, world, spec, config, 1);
+  EXPECT_GT(std::abs(*biased.corridors[0].length_m - 10.0), 0.04);
+}
+
+TEST(CloudEval, BadCorridorIntervalsAreNamed) {
+  std::vector<CorridorSpec> c = {{"lower", {"x", 0.0, {{0.2, 2.2}}}, {"x", 44.0, {{-1.8, -0.2}}}}};
+  EXPECT_EQ(check_corridors(c), "");
+  c[0].end_b.across = {{-0.2, -1.8}};
+  EXPECT_NE(check_corridors(c).find("corridor lower end_b"), std::string::npos);
+  c[0].end_b.across = {{-1.8, -0.2, 0.5}};
+  EXPECT_NE(check_corridors(c), "");
+  c[0].end_b.across = {};
+  EXPECT_NE(check_corridors(c), "");
+  c[0].end_b.across = {{-1.8, -0.2}};
+  c[0].end_a.axis = "z";
+  EXPECT_NE(check_corridors(c).find("end_a"), std::string::npos);
 }
 
 TEST(CloudEval, DescribeGivesTheUsualStatistics) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "channels.hpp"
@@ -17,7 +18,8 @@ constexpr int64_t kT0 = 1'700'000'000'000'000;
 constexpr int64_t kPoseDt = 20'000;  // [us] 50 Hz frontend
 constexpr int kKeyEvery = 15;
 
-class GraphTest : public ::testing::Test {
+// Parameter: the mapper on its own worker thread (live) or inline (replay).
+class GraphTest : public ::testing::TestWithParam<bool> {
  protected:
   void SetUp() override {
     mapper::MapperConfig mc;
@@ -27,10 +29,13 @@ class GraphTest : public ::testing::Test {
         Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
     T_base_laser.translation() = Eigen::Vector3d(0.4, 0, 1.0);
     densifier_ = std::make_unique<densifier::DensifierNode>(bus_, densifier::DensifierConfig{});
-    mapper_ = std::make_unique<mapper::MapperNode>(bus_, mc, T_base_laser);
-    bus_.subscribe<dense_segment_t>(
-        channels::kDenseSegment, [this](const dense_segment_t& m) { segments_.push_back(m); },
-        true);
+    mapper_ = std::make_unique<mapper::MapperNode>(
+        bus_, mc, T_base_laser,
+        [this](const std::string& name, double v) { mapper_counters_[name] = v; }, GetParam());
+    bus_.subscribe<dense_segments_t>(channels::kDenseSegments, [this](const dense_segments_t& m) {
+      messages_.push_back(m);
+      segments_.insert(segments_.end(), m.segments.begin(), m.segments.end());
+    });
     // One bus for producer and listener: its order check would see the producer's own last
     // time, so the test checks the order itself.
     bus_.subscribe<pose2d_t>(
@@ -40,8 +45,9 @@ class GraphTest : public ::testing::Test {
     while (bus_.lcm().handleTimeout(0) > 0) {
     }
   }
-  void send_keys(const std::vector<int>& indices, double y) {
+  void send_keys(const std::vector<int>& indices, double y, int optimisation = 1) {
     key_poses_t msg{};
+    msg.optimisation = optimisation;
     msg.utime = kT0 + indices.back() * kKeyEvery * kPoseDt;
     msg.parts = 1;
     for (int k : indices) {
@@ -69,28 +75,35 @@ class GraphTest : public ::testing::Test {
     bus_.publish(channels::kScanProfile, s);
   }
 
+  // Frontend poses 0..n_poses 1 cm north of the truth, key poses (the truth) every kKeyEvery.
+  void drive(int n_poses, bool profiles) {
+    for (int i = 0; i <= n_poses; ++i) {
+      pose2d_t p{};
+      p.utime = kT0 + i * kPoseDt;
+      p.parent_frame = "map";
+      p.child_frame = "base";
+      p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
+      p.y = 0.01;
+      bus_.publish(channels::kPoseFrontend, p);
+      if (i % kKeyEvery == 0) send_keys({i / kKeyEvery}, 0.0);
+      if (profiles && i % 3 == 0 && i + 2 <= n_poses) send_profile(p.utime);
+      handle_all();
+      mapper_->flush();
+    }
+  }
+
   Bus bus_{"memq://"};
   std::unique_ptr<densifier::DensifierNode> densifier_;
   std::unique_ptr<mapper::MapperNode> mapper_;
+  std::vector<dense_segments_t> messages_;
   std::vector<dense_segment_t> segments_;
   std::vector<pose2d_t> dense_;
+  std::map<std::string, double> mapper_counters_;
 };
 
-TEST_F(GraphTest, CorrectedTrajectoryPlacesProfilesAndFollowsReoptimisation) {
+TEST_P(GraphTest, CorrectedTrajectoryPlacesProfilesAndFollowsReoptimisation) {
   // 2 s at 0.5 m/s; the frontend is 1 cm north of the truth, the key poses are the truth.
-  for (int i = 0; i <= 100; ++i) {
-    pose2d_t p{};
-    p.utime = kT0 + i * kPoseDt;
-    p.parent_frame = "map";
-    p.child_frame = "base";
-    p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
-    p.y = 0.01;
-    bus_.publish(channels::kPoseFrontend, p);
-    if (i % kKeyEvery == 0) send_keys({i / kKeyEvery}, 0.0);
-    if (i % 3 == 0 && i + 2 <= 100) send_profile(p.utime);
-    handle_all();
-    mapper_->tick();
-  }
+  drive(100, true);
   ASSERT_EQ(segments_.size(), 6u);  // keys 0..6 -> 6 segments
   for (const auto& s : segments_) EXPECT_EQ(s.revision, 0);
   ASSERT_EQ(dense_.size(), 91u);  // poses 0..90, each once, in order
@@ -117,14 +130,68 @@ TEST_F(GraphTest, CorrectedTrajectoryPlacesProfilesAndFollowsReoptimisation) {
   EXPECT_EQ(segments_[1].revision, 1);
   EXPECT_NEAR(segments_[1].y.front(), 0.05, 1e-12);
   EXPECT_EQ(dense_.size(), 91u);  // the growing trajectory is not sent again
-  mapper_->tick();
+  mapper_->flush();
   EXPECT_GT(mapper_->mapper().profiles_replaced(), 0);
   int moved = 0;
   mapper_->mapper().for_each_point([&](const mapper::CloudPoint& p) {
     if (p.utime >= kT0 + 5 * kKeyEvery * kPoseDt && p.p_world.y() > 2.04) ++moved;
   });
   EXPECT_GT(moved, 0);
+  mapper_->report_counters();
+  EXPECT_EQ(mapper_counters_["segments_applied"], 8);
+  EXPECT_EQ(mapper_counters_["segments_stale"], 0);
 }
+
+// A loop closure that moves 900 segments at once: they leave in a few messages, each under the
+// configured size and all of one publish sharing utime, optimisation and a part count, and every
+// one of them reaches the mapper. A repeated (stale) revision is counted and ignored.
+TEST_P(GraphTest, BurstOfMovedSegmentsGoesOutInFewWholeMessages) {
+  constexpr int kSegments = 900;
+  drive(kSegments * kKeyEvery, false);
+  ASSERT_EQ(segments_.size(), static_cast<std::size_t>(kSegments));
+  const std::size_t messages_before = messages_.size();
+  segments_.clear();
+  messages_.clear();
+
+  std::vector<int> all;
+  for (int k = 0; k <= kSegments; ++k) all.push_back(k);
+  send_keys(all, 0.05, 2);  // everything moves 5 cm north
+  handle_all();
+  mapper_->flush();
+  ASSERT_EQ(segments_.size(), static_cast<std::size_t>(kSegments));
+  // 16 poses of 32 bytes plus 28 bytes per segment: ~540 bytes, ~110 per 60 kB message.
+  const int limit = densifier::DensifierConfig{}.max_message_bytes;
+  ASSERT_GE(messages_.size(), 2u);
+  EXPECT_LE(messages_.size(), 10u);
+  for (std::size_t i = 0; i < messages_.size(); ++i) {
+    const dense_segments_t& m = messages_[i];
+    EXPECT_LE(m.getEncodedSize(), limit);
+    EXPECT_EQ(m.part, static_cast<int32_t>(i));
+    EXPECT_EQ(m.parts, static_cast<int32_t>(messages_.size()));
+    EXPECT_EQ(m.optimisation, 2);
+    EXPECT_EQ(m.utime, kT0 + kSegments * kKeyEvery * kPoseDt);    // newest frontend pose
+    EXPECT_EQ(m.seq, static_cast<int64_t>(messages_before + i));  // numbered from 0
+  }
+  for (int k = 0; k < kSegments; ++k) {
+    EXPECT_EQ(segments_[k].key_id_first, k);
+    EXPECT_EQ(segments_[k].revision, 1);
+  }
+  mapper_->report_counters();
+  EXPECT_EQ(mapper_counters_["segments_applied"], 2 * kSegments);
+  EXPECT_EQ(mapper_counters_["segments_stale"], 0);
+  EXPECT_EQ(bus_.stats().at(channels::kDenseSegments).missed, 0);
+
+  // The same revisions again (e.g. a duplicated message) change nothing and count as stale.
+  dense_segments_t again = messages_.front();
+  bus_.publish(channels::kDenseSegments, again);
+  handle_all();
+  mapper_->report_counters();
+  EXPECT_EQ(mapper_counters_["segments_applied"], 2 * kSegments);
+  EXPECT_EQ(mapper_counters_["segments_stale"], again.n_segments);
+}
+
+INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "worker" : "inline"; });
 
 }  // namespace
 }  // namespace traverse

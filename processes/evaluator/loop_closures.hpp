@@ -1,0 +1,74 @@
+// Checking the backend's loop closures against the reference trajectory.
+//
+// A closure measures Z = T_from_to, the pose of key pose `to` in the frame of key pose `from`.
+// The truth is T_true = T_ref(from_utime)^-1 T_ref(to_utime), the reference interpolated at both
+// times (independent of any alignment of the estimate). The error is the one the backend's pose
+// graph minimises (g2o EDGE_SE2, processes/backend/pose_graph.hpp):
+//   e = t2v(Z^-1 T_true)   (translation in Z's frame, angle wrapped),
+// and the closure's covariance C is the covariance of that error. A closure is false when its
+// Mahalanobis distance sqrt(e^T C^-1 e) exceeds a number of standard deviations (config
+// false_closure_sigmas): the matcher claimed a precision the truth does not bear out.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "trajectory.hpp"
+
+namespace traverse::evaluator {
+
+struct LoopClosure {
+  int64_t from_id = 0;     // older key pose
+  int64_t to_id = 0;       // current key pose
+  int64_t from_utime = 0;  // [us] time of from_id
+  int64_t to_utime = 0;    // [us] time of to_id
+  Pose2 T_from_to;         // the measurement Z
+  // Covariance of the error (x [m], y [m], theta [rad]) in to's frame: m^2, m*rad, rad^2.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+// Closures by (from_id, to_id): a repeated closure replaces the earlier copy.
+class LoopClosureSet {
+ public:
+  void add(const LoopClosure& closure);
+  std::vector<LoopClosure> closures() const;  // ordered by (from_id, to_id)
+  std::size_t size() const { return by_ids_.size(); }
+  std::size_t repeated() const { return repeated_; }
+
+ private:
+  std::map<std::pair<int64_t, int64_t>, LoopClosure> by_ids_;
+  std::size_t repeated_ = 0;
+};
+
+struct ClosureCheck {
+  LoopClosure closure;
+  bool matched = false;  // both times inside the reference (trajectory.hpp's matching rules)
+  Pose2 T_true;          // T_ref(from)^-1 T_ref(to), when matched
+  Eigen::Vector3d error = Eigen::Vector3d::Zero();  // e: [m], [m], [rad], when matched
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();  // sqrt(diag C): [m], [m], [rad]
+  // sqrt(e^T C^-1 e) [unitless]; nullopt when C is not a finite positive-definite matrix.
+  std::optional<double> mahalanobis;
+  bool is_false = false;  // mahalanobis > false_closure_sigmas
+};
+
+struct ClosureEvaluation {
+  std::vector<ClosureCheck> checks;  // one per closure, same order as given
+  std::size_t closures = 0;
+  std::size_t false_closures = 0;
+  std::size_t unmatched = 0;
+  std::size_t bad_covariance = 0;  // matched, but C not positive definite: neither true nor false
+  std::optional<double> max_mahalanobis;  // [unitless] over matched closures with a valid C
+  std::optional<double> max_error_m;      // [m] largest |e_xy| over matched closures
+  std::optional<double> rms_error_m;      // [m] RMS of |e_xy| over matched closures
+};
+
+// `reference` in any order (repeated times keep their first pose); `false_sigmas` > 0.
+ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Trajectory reference,
+                                 const MatchConfig& match, double false_sigmas);
+
+}  // namespace traverse::evaluator

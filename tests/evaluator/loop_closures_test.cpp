@@ -1,0 +1,132 @@
+#include "loop_closures.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "synthetic.hpp"
+
+namespace traverse::evaluator {
+namespace {
+
+using test::circle_pose;
+using test::circle_truth;
+
+constexpr double kSigmaXM = 0.01, kSigmaYM = 0.02, kSigmaThetaRad = 0.005;
+
+// A closure between the truth at two times whose error e = t2v(Z^-1 T_true) is exactly `error`
+// (Z = T_true * E^-1), with a diagonal covariance of the sigmas above.
+LoopClosure closure(int64_t from_id, int64_t to_id, int64_t from_us, int64_t to_us,
+                    const Pose2& error = Pose2()) {
+  LoopClosure c;
+  c.from_id = from_id;
+  c.to_id = to_id;
+  c.from_utime = from_us;
+  c.to_utime = to_us;
+  const Pose2 T_true = between(circle_pose(1e-6 * static_cast<double>(from_us)),
+                               circle_pose(1e-6 * static_cast<double>(to_us)));
+  c.T_from_to = T_true * error.inverse();
+  c.covariance.diagonal() << kSigmaXM * kSigmaXM, kSigmaYM * kSigmaYM,
+      kSigmaThetaRad * kSigmaThetaRad;
+  return c;
+}
+
+constexpr double kFive = 5.0;
+
+TEST(LoopClosures, ExactClosureIsTrue) {
+  // 1.5 s and 18.25 s: between ground-truth samples, so interpolation is exercised too.
+  const ClosureEvaluation ev =
+      check_closures({closure(3, 40, 1'502'500, 18'250'000)}, circle_truth(20), {}, kFive);
+  ASSERT_EQ(ev.checks.size(), 1u);
+  EXPECT_EQ(ev.closures, 1u);
+  EXPECT_EQ(ev.false_closures, 0u);
+  EXPECT_EQ(ev.unmatched, 0u);
+  ASSERT_TRUE(ev.max_mahalanobis && ev.rms_error_m && ev.max_error_m);
+  EXPECT_NEAR(*ev.max_mahalanobis, 0.0, 1e-6);
+  EXPECT_NEAR(*ev.max_error_m, 0.0, 1e-9);
+  EXPECT_FALSE(ev.checks[0].is_false);
+}
+
+TEST(LoopClosures, SixSigmaOffIsFalseFourSigmaIsNot) {
+  const std::vector<LoopClosure> closures = {
+      closure(1, 30, 2'000'000, 15'000'000, Pose2(6 * kSigmaXM, 0.0, 0.0)),        // 6 sigma x
+      closure(2, 31, 3'000'000, 16'000'000, Pose2(0.0, 0.0, 6 * kSigmaThetaRad)),  // 6 sigma theta
+      closure(3, 32, 4'000'000, 17'000'000, Pose2(0.0, 4 * kSigmaYM, 0.0)),        // 4 sigma y
+  };
+  const ClosureEvaluation ev = check_closures(closures, circle_truth(20), {}, kFive);
+  EXPECT_EQ(ev.false_closures, 2u);
+  ASSERT_EQ(ev.checks.size(), 3u);
+  EXPECT_TRUE(ev.checks[0].is_false);
+  EXPECT_TRUE(ev.checks[1].is_false);
+  EXPECT_FALSE(ev.checks[2].is_false);
+  EXPECT_NEAR(*ev.checks[0].mahalanobis, 6.0, 1e-6);
+  EXPECT_NEAR(*ev.checks[1].mahalanobis, 6.0, 1e-6);
+  EXPECT_NEAR(*ev.checks[2].mahalanobis, 4.0, 1e-6);
+  // The error is expressed in Z's frame, component by component.
+  EXPECT_NEAR(ev.checks[0].error.x(), 6 * kSigmaXM, 1e-9);
+  EXPECT_NEAR(ev.checks[0].error.y(), 0.0, 1e-9);
+  EXPECT_NEAR(ev.checks[2].error.y(), 4 * kSigmaYM, 1e-9);
+  EXPECT_NEAR(*ev.max_error_m, 4 * kSigmaYM, 1e-9);
+  EXPECT_NEAR(*ev.rms_error_m,
+              std::sqrt((std::pow(6 * kSigmaXM, 2) + std::pow(4 * kSigmaYM, 2)) / 3.0), 1e-9);
+  EXPECT_NEAR(*ev.max_mahalanobis, 6.0, 1e-6);
+  // The threshold is the config's: at 7 sigma none of them is false.
+  EXPECT_EQ(check_closures(closures, circle_truth(20), {}, 7.0).false_closures, 0u);
+}
+
+TEST(LoopClosures, CorrelatedCovarianceIsUsedWhole) {
+  // Errors along a strongly correlated x-y direction are cheap; across it they are expensive.
+  LoopClosure along = closure(1, 2, 2'000'000, 9'000'000, Pose2(0.03, 0.03, 0.0));
+  LoopClosure across = closure(3, 4, 2'000'000, 9'000'000, Pose2(0.03, -0.03, 0.0));
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  C << 1e-4, 0.99e-4, 0, 0.99e-4, 1e-4, 0, 0, 0, 1e-6;
+  along.covariance = across.covariance = C;
+  const ClosureEvaluation ev = check_closures({along, across}, circle_truth(10), {}, kFive);
+  ASSERT_EQ(ev.checks.size(), 2u);
+  // e^T C^-1 e: along (1,1)/sqrt2 the variance is 1.99e-4, across 0.01e-4.
+  EXPECT_NEAR(*ev.checks[0].mahalanobis, std::sqrt(2 * 0.03 * 0.03 / 1.99e-4), 1e-6);
+  EXPECT_NEAR(*ev.checks[1].mahalanobis, std::sqrt(2 * 0.03 * 0.03 / 0.01e-4), 1e-6);
+  EXPECT_FALSE(ev.checks[0].is_false);
+  EXPECT_TRUE(ev.checks[1].is_false);
+}
+
+TEST(LoopClosures, TimesOutsideTheReferenceAreUnmatched) {
+  const std::vector<LoopClosure> closures = {
+      closure(0, 9, 500'000, 5'000'000),      // from before the reference starts
+      closure(1, 10, 2'000'000, 40'000'000),  // to after it ends
+      closure(2, 11, 2'000'000, 6'000'000),   // fine
+  };
+  const ClosureEvaluation ev = check_closures(closures, circle_truth(10), {}, kFive);
+  EXPECT_EQ(ev.closures, 3u);
+  EXPECT_EQ(ev.unmatched, 2u);
+  EXPECT_EQ(ev.false_closures, 0u);
+  EXPECT_FALSE(ev.checks[0].matched);
+  EXPECT_TRUE(ev.checks[2].matched);
+  // Nothing matched: figures are absent, not zero.
+  const ClosureEvaluation none = check_closures({closures[0]}, circle_truth(10), {}, kFive);
+  EXPECT_FALSE(none.max_mahalanobis || none.max_error_m || none.rms_error_m);
+}
+
+TEST(LoopClosures, CovarianceThatIsNotPositiveDefiniteIsReported) {
+  LoopClosure c = closure(1, 2, 2'000'000, 6'000'000, Pose2(1.0, 0.0, 0.0));
+  c.covariance.setZero();
+  const ClosureEvaluation ev = check_closures({c}, circle_truth(10), {}, kFive);
+  EXPECT_EQ(ev.bad_covariance, 1u);
+  EXPECT_EQ(ev.false_closures, 0u);
+  EXPECT_FALSE(ev.checks[0].mahalanobis);
+  EXPECT_NEAR(*ev.max_error_m, 1.0, 1e-9);
+}
+
+TEST(LoopClosureSet, RepeatedClosureIsKeptOnce) {
+  LoopClosureSet set;
+  set.add(closure(1, 2, 2'000'000, 6'000'000, Pose2(1.0, 0.0, 0.0)));
+  set.add(closure(1, 3, 2'000'000, 7'000'000));
+  set.add(closure(1, 2, 2'000'000, 6'000'000));  // the same pair again: replaces the first
+  EXPECT_EQ(set.size(), 2u);
+  EXPECT_EQ(set.repeated(), 1u);
+  const ClosureEvaluation ev = check_closures(set.closures(), circle_truth(10), {}, kFive);
+  EXPECT_NEAR(*ev.max_error_m, 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace traverse::evaluator
