@@ -180,11 +180,7 @@ void Backend::add_key_pose(const PlanarScan& scan) {
           T_world_key = r.T_world_query;
         }
       }
-      // The response spread says nothing of the grid itself: a match on cells of r metres and
-      // steps of a radians is uncertain by at least r^2 / 12 and a^2 / 12 (uniform rounding).
-      const double r = config_.link.resolution_m, a = config_.link.angle_step_rad;
-      covariance = to_pose_frame(m.covariance, T_world_key) +
-                   Eigen::Vector3d(r * r / 12.0, r * r / 12.0, a * a / 12.0).asDiagonal().toDenseMatrix();
+      covariance = to_pose_frame(m.covariance, T_world_key);
     } else {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;

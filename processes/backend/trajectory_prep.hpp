@@ -32,8 +32,8 @@ struct JumpSmoothingConfig {
   double max_direction_change_rad = 1.0;  // step direction vs average direction, while moving
   double min_moving_speed_mps = 0.1;  // below this average speed, direction is not checked [m/s]
   double max_turn_rate_radps = 3.0;   // a heading rate above this [rad/s] is a jump
-  double min_jump_m = 0.005;    // a jump displaces the pose by more than this from the average [m]
-  double min_jump_rad = 0.005;  // ... or turns it by more than this [rad]
+  double min_jump_m = 0.3;    // a jump displaces the pose by more than this from the average [m]
+  double min_jump_rad = 0.1;  // ... or turns it by more than this [rad]
 
   template <class V>
   void visit(V& v) {

@@ -75,7 +75,10 @@ TEST(JumpSmoothing, ReplacesAnOutlierWithoutMovingWhatFollows) {
   std::vector<StampedPose> poses = drive(100, 0.35, 0.0);
   const std::vector<StampedPose> clean = poses;
   poses[50].T_world_base = poses[50].T_world_base * Pose2(0.004, -0.012, 0.0);
-  const SmoothedTrajectory s = smooth_jumps(poses, {});
+  JumpSmoothingConfig config;
+  config.min_jump_m = 0.005;  // a 12 mm outlier counts
+  EXPECT_TRUE(smooth_jumps(poses, {}).outliers.empty());  // by default it is left to the links
+  const SmoothedTrajectory s = smooth_jumps(poses, config);
   EXPECT_TRUE(s.replaced_steps.empty());
   ASSERT_EQ(s.outliers, std::vector<int>{50});
   for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -89,11 +92,13 @@ TEST(JumpSmoothing, ReplacesAnOutlierWithoutMovingWhatFollows) {
 TEST(JumpSmoothing, DeviationsBelowTheMinimumAreNotJumps) {
   // 4 mm sideways at 0.2 m/s (5 mm per scan) turns the step by 0.67 rad: matching noise, not a
   // jump, unless the minimum and the direction limit are set tighter.
+  JumpSmoothingConfig fine;
+  fine.min_jump_m = 0.005;
   std::vector<StampedPose> poses = drive(100, 0.2, 0.0);
   for (std::size_t k = 50; k < poses.size(); ++k) {
     poses[k].T_world_base = Pose2(0.0, 0.004, 0.0) * poses[k].T_world_base;
   }
-  const SmoothedTrajectory s = smooth_jumps(poses, {});
+  const SmoothedTrajectory s = smooth_jumps(poses, fine);
   EXPECT_TRUE(s.replaced_steps.empty());
   EXPECT_TRUE(s.outliers.empty());
   JumpSmoothingConfig strict;
