@@ -174,10 +174,8 @@ TEST_F(EvaluatorProgram, NoMatchIsAFailure) {
   EXPECT_EQ(json_number(r.last_line, "unmatched"), 401);
 }
 
-// Ground truth for 1..11 s and the backend's incremental key poses: a first estimate 0.5 m off,
-// then an optimisation that moves every key pose onto the truth, with loop closures.
-void write_key_poses_log(const std::string& path) {
-  LogFilePublisher out(path);
+// The ground truth of test::circle_truth(10) on POSE_GROUND_TRUTH.
+void publish_truth(LogFilePublisher& out) {
   for (const StampedPose& p : test::circle_truth(10)) {
     pose2d_t msg{};
     msg.utime = p.utime;
@@ -186,6 +184,13 @@ void write_key_poses_log(const std::string& path) {
     msg.theta = p.pose.theta();
     out.publish("POSE_GROUND_TRUTH", msg);
   }
+}
+
+// Ground truth for 1..11 s and the backend's incremental key poses: a first estimate 0.5 m off,
+// then an optimisation that moves every key pose onto the truth, with loop closures.
+void write_key_poses_log(const std::string& path) {
+  LogFilePublisher out(path);
+  publish_truth(out);
   using test::key_pose;
   using test::loop_closure;
   const std::vector<int64_t> t_us = {1'500'000, 3'000'000, 5'000'000, 7'000'000, 9'000'000};
@@ -257,14 +262,7 @@ TEST_F(EvaluatorProgram, DenseSegmentsNewestRevision) {
   const std::string log = (dir_ / "dense.lcmlog").string();
   {
     LogFilePublisher out(log);
-    for (const StampedPose& p : test::circle_truth(10)) {
-      pose2d_t msg{};
-      msg.utime = p.utime;
-      msg.x = p.pose.x();
-      msg.y = p.pose.y();
-      msg.theta = p.pose.theta();
-      out.publish("POSE_GROUND_TRUTH", msg);
-    }
+    publish_truth(out);
     using test::dense_segment;
     auto m1 = test::dense_segments(
         {dense_segment(0, 0, 1'000'000, 0.3), dense_segment(1, 0, 2'000'000, 0.3)});
@@ -289,14 +287,7 @@ TEST_F(EvaluatorProgram, MixedTypesOnTheEstimateChannelAreReported) {
   const std::string mixed = (dir_ / "mixed.lcmlog").string();
   {
     LogFilePublisher out(mixed);
-    for (const StampedPose& p : test::circle_truth(10)) {
-      pose2d_t msg{};
-      msg.utime = p.utime;
-      msg.x = p.pose.x();
-      msg.y = p.pose.y();
-      msg.theta = p.pose.theta();
-      out.publish("POSE_GROUND_TRUTH", msg);
-    }
+    publish_truth(out);
     auto k = test::key_poses(1, {test::key_pose(0, 2'000'000), test::key_pose(1, 4'000'000)});
     out.publish("KEY_POSES", k);
     pose2d_t stray{};  // a pose2d_t publisher on the key poses' channel
