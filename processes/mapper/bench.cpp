@@ -62,8 +62,16 @@ int main(int argc, char** argv) {
       gt.push_back(e->ground_truth.T_world_base);
     } else if (e->kind == ts::SimEvent::Kind::kScanProfile) {
       const ts::ScanData& s = e->scan;
-      profiles.push_back(
-          {s.utime_first, s.utime_last, s.angle_first, s.angle_step, s.ranges, s.intensities});
+      tm::Profile p;
+      p.utime_first = s.utime_first;
+      p.utime_last = s.utime_last;
+      p.angle_first = s.angle_first;
+      p.angle_step = s.angle_step;
+      p.range_min = s.range_min;
+      p.range_max = s.range_max;
+      p.ranges = s.ranges;
+      p.intensities = s.intensities;
+      profiles.push_back(std::move(p));
     }
   }
   std::fprintf(stderr, "simulated %.0f s: %zu profiles, %zu true poses in %.1f s\n", duration_s,

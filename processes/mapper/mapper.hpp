@@ -29,6 +29,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "planar_scan.hpp"
 #include "trajectory_store.hpp"
 
 namespace traverse::mapper {
@@ -74,11 +75,9 @@ struct MapperConfig {
 };
 
 // One sweep of the profile scanner as measured (planar_scan_t without the transport fields).
-struct Profile {
-  int64_t utime_first = 0, utime_last = 0;  // [us]
-  float angle_first = 0, angle_step = 0;    // [rad] in the laser frame
-  std::vector<float> ranges;                // [m]
-  std::vector<uint8_t> intensities;         // [0..255], empty or one per range
+// A profile of the tilted scanner: the common scan plus its intensities.
+struct Profile : PlanarScan {
+  std::vector<uint8_t> intensities;  // [0..255], empty or one per range
 };
 
 struct CloudPoint {

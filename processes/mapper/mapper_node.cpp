@@ -5,6 +5,7 @@
 
 #include "channels.hpp"
 #include "ply.hpp"
+#include "scan_message.hpp"
 
 namespace traverse::mapper {
 
@@ -32,12 +33,7 @@ MapperNode::~MapperNode() {
 }
 
 void MapperNode::on_profile(const planar_scan_t& msg) {
-  Profile p;
-  p.utime_first = msg.utime_first;
-  p.utime_last = msg.utime_last;
-  p.angle_first = msg.angle_first;
-  p.angle_step = msg.angle_step;
-  p.ranges = msg.ranges;
+  Profile p{to_planar_scan(msg), {}};
   if (msg.n_intensities8 == msg.n_ranges) {
     p.intensities = msg.intensities8;
   } else if (msg.n_intensities16 == msg.n_ranges) {

@@ -17,12 +17,7 @@ class CollectorLive : public ::testing::Test {
 
   void publish_truth() {
     for (const StampedPose& p : test::circle_truth(10)) {
-      pose2d_t msg{};
-      msg.utime = p.utime;
-      msg.x = p.pose.x();
-      msg.y = p.pose.y();
-      msg.theta = p.pose.theta();
-      publish("POSE_GROUND_TRUTH", msg);
+      publish("POSE_GROUND_TRUTH", test::pose_message(p));
     }
   }
 

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "bus.hpp"
+#include "messages.hpp"
 #include "synthetic.hpp"
 #include "traverse/pose2d_t.hpp"
 #include "traverse/process_status_t.hpp"
@@ -72,11 +73,7 @@ TEST(EvaluatorLive, WritesItsSummaryWhenStopped) {
     // 2 s of ground truth at 200 Hz, a frontend at 40 Hz 0.1 m off in y.
     int frontend = 0;
     for (const StampedPose& p : test::circle_truth(2)) {
-      pose2d_t msg{};
-      msg.utime = p.utime;
-      msg.x = p.pose.x();
-      msg.y = p.pose.y();
-      msg.theta = p.pose.theta();
+      pose2d_t msg = test::pose_message(p);
       bus.publish("POSE_GROUND_TRUTH", msg);
       if ((p.utime / 5'000) % 5 == 0) {
         msg.y += 0.1;

@@ -8,8 +8,19 @@
 #include "synthetic.hpp"
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/key_poses_t.hpp"
+#include "traverse/pose2d_t.hpp"
 
 namespace traverse::evaluator::test {
+
+// A trajectory pose as a pose2d_t message (frames left empty).
+inline pose2d_t pose_message(const StampedPose& p) {
+  pose2d_t msg{};
+  msg.utime = p.utime;
+  msg.x = p.pose.x();
+  msg.y = p.pose.y();
+  msg.theta = p.pose.theta();
+  return msg;
+}
 
 inline Pose2 circle_at(int64_t utime_us) {
   return circle_pose(1e-6 * static_cast<double>(utime_us));

@@ -177,11 +177,7 @@ TEST_F(EvaluatorProgram, NoMatchIsAFailure) {
 // The ground truth of test::circle_truth(10) on POSE_GROUND_TRUTH.
 void publish_truth(LogFilePublisher& out) {
   for (const StampedPose& p : test::circle_truth(10)) {
-    pose2d_t msg{};
-    msg.utime = p.utime;
-    msg.x = p.pose.x();
-    msg.y = p.pose.y();
-    msg.theta = p.pose.theta();
+    pose2d_t msg = test::pose_message(p);
     out.publish("POSE_GROUND_TRUTH", msg);
   }
 }
