@@ -118,8 +118,9 @@ bool Densifier::add_dense(int64_t utime, const Pose2& T_world_base, std::vector<
   if (!dense_.empty() && utime <= dense_.back().utime) return false;
   const int64_t previous = dense_.empty() ? utime - 1 : dense_.back().utime;
   dense_.push_back({utime, T_world_base});
-  // Key poses the dense data has just reached become placed; their segments can close.
   std::vector<Segment> out;
+  replace_spike(out);
+  // Key poses the dense data has just reached become placed; their segments can close.
   const auto end = keys_.upper_bound(utime);
   for (auto it = keys_.upper_bound(previous); it != end; ++it) {
     if (it->second.placed) continue;
@@ -129,6 +130,27 @@ bool Densifier::add_dense(int64_t utime, const Pose2& T_world_base, std::vector<
   }
   if (closed) closed->insert(closed->end(), out.begin(), out.end());
   return true;
+}
+
+void Densifier::replace_spike(std::vector<Segment>& out) {
+  const std::size_t n = dense_.size();
+  if (config_.spike_threshold_m <= 0.0 || n < 3) return;
+  const StampedPose& a = dense_[n - 3];
+  const StampedPose& b = dense_[n - 1];
+  StampedPose& p = dense_[n - 2];
+  const double s = static_cast<double>(p.utime - a.utime) / static_cast<double>(b.utime - a.utime);
+  const Pose2 q = interpolate(a.T_world_base, b.T_world_base, s);
+  const double off = (p.T_world_base.translation() - q.translation()).norm();
+  const double chord = (b.T_world_base.translation() - a.T_world_base.translation()).norm();
+  if (off <= config_.spike_threshold_m || off <= chord) return;
+  p.T_world_base = q;
+  ++spikes_replaced_;
+  // The segment over the pose, and the one before when a key pose sits exactly on it.
+  const auto after = keys_.upper_bound(p.utime);
+  if (after == keys_.begin()) return;
+  const auto at = std::prev(after);
+  refresh_segment(at, out);
+  if (at->first == p.utime && at != keys_.begin()) refresh_segment(std::prev(at), out);
 }
 
 std::vector<Segment> Densifier::update_key_poses(const std::vector<KeyPose>& keys) {

@@ -17,6 +17,12 @@
 //
 // The Densifier keeps the whole dense trajectory and the key poses, which may be re-optimised
 // any number of times; it returns the segments whose corrected poses appeared or moved.
+//
+// A single frontend pose far off the path between its two neighbours (farther than
+// `spike_threshold_m` and farther than the neighbours are from each other) is a wrong match the
+// frontend undid at once; it is replaced by interpolating its neighbours before anything is bent.
+// Bending keeps such a spike (office-s1: poses 0.1-0.2 m off, each between two good ones), and
+// the profiles placed with it.
 #pragma once
 
 #include <cstdint>
@@ -40,6 +46,8 @@ struct DensifierConfig {
   std::string key_pose_channel = "KEY_POSES";  // key_poses_t from the backend
   // [bytes] largest encoded dense_segments_t: under 64 KB, one UDP datagram's worth.
   int max_message_bytes = 60000;
+  double spike_threshold_m = 0.02;  // [m] a lone frontend pose this far off its neighbours' path
+                                    // is replaced (0: never)
   template <class V>
   void visit(V& v) {
     v("mode", mode);
@@ -49,6 +57,7 @@ struct DensifierConfig {
     v("parent_frame", parent_frame);
     v("key_pose_channel", key_pose_channel);
     v("max_message_bytes", max_message_bytes);
+    v("spike_threshold_m", spike_threshold_m);
   }
 };
 
@@ -104,6 +113,7 @@ class Densifier {
   std::size_t dense_size() const { return dense_.size(); }
   std::size_t key_size() const { return keys_.size(); }
   int64_t segments_moved() const { return segments_moved_; }
+  int64_t spikes_replaced() const { return spikes_replaced_; }
 
  private:
   struct KeyState {
@@ -120,6 +130,9 @@ class Densifier {
   // Recomputes the segment starting at key `it`; appends it to `out` if new or moved.
   void refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out,
                        bool exact = false);
+  // Replaces the second newest dense pose if it is a spike (see above); segments already closed
+  // over it are computed again into `out`.
+  void replace_spike(std::vector<Segment>& out);
   // Correction K D^-1 of a placed key pose.
   Pose2 correction(const KeyState& k) const;
 
@@ -129,6 +142,7 @@ class Densifier {
   std::map<int64_t, KeyState> keys_;          // by utime
   std::map<int64_t, SegmentState> segments_;  // by start key utime
   int64_t segments_moved_ = 0;
+  int64_t spikes_replaced_ = 0;
 };
 
 }  // namespace traverse::densifier

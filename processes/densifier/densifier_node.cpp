@@ -118,6 +118,7 @@ void DensifierNode::report_counters() {
   counters_("segment_messages", segment_messages_);
   counters_("oversize_messages", oversize_messages_);
   counters_("segments_moved", static_cast<double>(densifier_.segments_moved()));
+  counters_("spikes_replaced", static_cast<double>(densifier_.spikes_replaced()));
   counters_("dense_rejected", dense_rejected_);
 }
 

@@ -17,6 +17,11 @@ int main(int argc, char** argv) {
     spdlog::error("{}: mode must be paper or rigid, not '{}'", proc.config_path(), config.mode);
     return traverse::kConfigErrorExitCode;
   }
+  if (!(config.spike_threshold_m >= 0.0)) {
+    spdlog::error("{}: spike_threshold_m must be >= 0 (0: never), not {}", proc.config_path(),
+                  config.spike_threshold_m);
+    return traverse::kConfigErrorExitCode;
+  }
   // Below a few kilobytes a message holds only a handful of segments and bursts grow long again.
   if (config.max_message_bytes < 4096) {
     spdlog::error("{}: max_message_bytes must be at least 4096, not {}", proc.config_path(),

@@ -88,6 +88,7 @@ void MapperNode::submit(Work work) {
   {
     std::lock_guard lock(mutex_);
     queue_.push_back(std::move(work));
+    queued_at_.push_back(std::chrono::steady_clock::now());
     ++submitted_;
     max_queued_ = std::max(max_queued_, queue_.size());
   }
@@ -136,10 +137,16 @@ void MapperNode::run_worker() {
     // Everything queued so far, then the moves once: a loop closure arrives as many segments.
     std::deque<Work> batch;
     batch.swap(queue_);
+    const auto oldest = queued_at_.front();
+    queued_at_.clear();
     lock.unlock();
     for (Work& w : batch) apply(w);
     settle();
     lock.lock();
+    // How far the map trails what has arrived: a loop closure's moved points are in the map
+    // (and the cloud) this long after its segments came in.
+    lag_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - oldest).count();
+    lag_max_s_ = std::max(lag_max_s_, lag_s_);
     done_ += static_cast<int64_t>(batch.size());
     idle_cv_.notify_all();
   }
@@ -184,12 +191,14 @@ bool MapperNode::export_all(std::string* error) {
 void MapperNode::report_counters() {
   if (!counters_) return;
   Snapshot s;
-  double queued = 0, max_queued = 0;
+  double queued = 0, max_queued = 0, lag = 0, lag_max = 0;
   {
     std::lock_guard lock(mutex_);
     s = snapshot_;
     queued = static_cast<double>(queue_.size());
     max_queued = static_cast<double>(max_queued_);
+    lag = lag_s_;
+    lag_max = lag_max_s_;
   }
   counters_("profiles", s.profiles);
   counters_("profiles_pending", s.pending);
@@ -205,6 +214,8 @@ void MapperNode::report_counters() {
   counters_("segments_rejected", s.segments_rejected);
   counters_("work_queued", queued);
   counters_("work_queued_max", max_queued);
+  counters_("map_lag_s", lag);
+  counters_("map_lag_max_s", lag_max);
 }
 
 }  // namespace traverse::mapper

@@ -11,9 +11,12 @@
 // whole route), and a process that stops reading its socket for that long loses every datagram
 // that overflows the receive buffer (on office-s2 a third of the profiles and segment messages).
 // The queue keeps the order of arrival, so the result is the same as handling each message at
-// once; offline (--replay) the node works inline instead, which keeps memory bounded.
+// once; offline (--replay) the node works inline instead, which keeps memory bounded. The status
+// counters map_lag_s / map_lag_max_s say how long the map trails what has arrived [s]: the time
+// from the arrival of the oldest item of a batch until the batch, moves included, is in the map.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -88,6 +91,8 @@ class MapperNode {
   std::mutex mutex_;
   std::condition_variable work_cv_, idle_cv_;
   std::deque<Work> queue_;
+  std::deque<std::chrono::steady_clock::time_point> queued_at_;  // arrival of each queued item
+  double lag_s_ = 0.0, lag_max_s_ = 0.0;  // [s] arrival of a batch's oldest item to its settling
   int64_t submitted_ = 0, done_ = 0;
   std::size_t max_queued_ = 0;
   bool stop_ = false;

@@ -156,5 +156,43 @@ TEST(Densifier, MovesBelowTheThresholdWaitUntilTheEnd) {
   EXPECT_TRUE(d.settle().empty());  // once settled, nothing is left to send
 }
 
+// A lone frontend pose 0.15 m off the straight path is replaced by its neighbours'
+// interpolation, also inside a segment that was already closed; a sparse log's corner, where the
+// neighbours are farther apart than the middle pose is off their chord, is kept.
+TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
+  Densifier d(DensifierConfig{});
+  std::vector<Segment> closed;
+  ASSERT_TRUE(d.update_key_poses({{0, kT0, Pose2()}, {1, kT0 + 20 * kDt, Pose2(0.1, 0, 0)}})
+                  .empty());
+  for (int i = 0; i <= 20; ++i) {
+    d.add_dense(kT0 + i * kDt, Pose2(0.005 * i, i == 10 ? 0.15 : 0.0, 0), &closed);
+  }
+  EXPECT_EQ(d.spikes_replaced(), 1);
+  ASSERT_FALSE(closed.empty());
+  EXPECT_NEAR(closed.back().poses[10].T_world_base.y(), 0.0, 1e-12);
+  EXPECT_NEAR(d.pose_at(kT0 + 10 * kDt)->y(), 0.0, 1e-12);
+
+  // The spike is the pose a key pose sits on, in a segment closed before the next pose came.
+  Densifier e(DensifierConfig{});
+  closed.clear();
+  for (int i = 0; i <= 10; ++i) {
+    e.add_dense(kT0 + i * kDt, Pose2(0.005 * i, i == 10 ? 0.15 : 0.0, 0), &closed);
+  }
+  e.update_key_poses({{0, kT0, Pose2()}, {1, kT0 + 10 * kDt, Pose2(0.05, 0, 0)}});
+  closed.clear();
+  e.add_dense(kT0 + 11 * kDt, Pose2(0.055, 0, 0), &closed);
+  EXPECT_EQ(e.spikes_replaced(), 1);
+  ASSERT_EQ(closed.size(), 1u);
+  EXPECT_EQ(closed[0].revision, 1);
+  EXPECT_NEAR(closed[0].poses[5].T_world_base.y(), 0.0, 1e-12);  // the correction is gone
+
+  // A sparse log turning a corner: 1 m steps, the middle pose 0.7 m off its neighbours' chord.
+  Densifier f(DensifierConfig{});
+  f.add_dense(kT0, Pose2(0, 0, 0), &closed);
+  f.add_dense(kT0 + 1'000'000, Pose2(1, 0, 0), &closed);
+  f.add_dense(kT0 + 2'000'000, Pose2(1, 1, 0), &closed);
+  EXPECT_EQ(f.spikes_replaced(), 0);
+}
+
 }  // namespace
 }  // namespace traverse::densifier
