@@ -7,15 +7,15 @@
 namespace traverse::backend {
 namespace {
 
+// Time from a to b [s]; equal times count as 1 us.
+double seconds(const StampedPose& a, const StampedPose& b) {
+  return 1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1));
+}
+
 // A step as a body-frame velocity: (vx [m/s], vy [m/s], omega [rad/s]).
 Eigen::Vector3d velocity(const StampedPose& a, const StampedPose& b) {
   const Pose2 step = between(a.T_world_base, b.T_world_base);
-  return Eigen::Vector3d(step.x(), step.y(), step.theta()) /
-         (1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1)));
-}
-
-double seconds(const StampedPose& a, const StampedPose& b) {
-  return 1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1));
+  return Eigen::Vector3d(step.x(), step.y(), step.theta()) / seconds(a, b);
 }
 
 // Whether velocity v over dt [s] is a jump against the mean velocity of the preceding steps.

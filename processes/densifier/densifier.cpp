@@ -13,6 +13,16 @@ std::optional<Mode> parse_mode(const std::string& name) {
   return std::nullopt;
 }
 
+namespace {
+
+// The pose at `utime` on the geodesic from lo to hi (lo.utime < hi.utime).
+Pose2 interpolate_between(const StampedPose& lo, const StampedPose& hi, int64_t utime) {
+  const double s = static_cast<double>(utime - lo.utime) / static_cast<double>(hi.utime - lo.utime);
+  return interpolate(lo.T_world_base, hi.T_world_base, s);
+}
+
+}  // namespace
+
 std::optional<Pose2> interpolate_at(const std::vector<StampedPose>& poses, int64_t utime) {
   if (poses.empty() || utime < poses.front().utime || utime > poses.back().utime) {
     return std::nullopt;
@@ -20,10 +30,7 @@ std::optional<Pose2> interpolate_at(const std::vector<StampedPose>& poses, int64
   auto hi = std::lower_bound(poses.begin(), poses.end(), utime,
                              [](const StampedPose& p, int64_t t) { return p.utime < t; });
   if (hi->utime == utime) return hi->T_world_base;
-  auto lo = hi - 1;
-  const double s =
-      static_cast<double>(utime - lo->utime) / static_cast<double>(hi->utime - lo->utime);
-  return interpolate(lo->T_world_base, hi->T_world_base, s);
+  return interpolate_between(*(hi - 1), *hi, utime);
 }
 
 namespace {
@@ -138,8 +145,7 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   const StampedPose& a = dense_[n - 3];
   const StampedPose& b = dense_[n - 1];
   StampedPose& p = dense_[n - 2];
-  const double s = static_cast<double>(p.utime - a.utime) / static_cast<double>(b.utime - a.utime);
-  const Pose2 q = interpolate(a.T_world_base, b.T_world_base, s);
+  const Pose2 q = interpolate_between(a, b, p.utime);
   const double off = (p.T_world_base.translation() - q.translation()).norm();
   const double chord = (b.T_world_base.translation() - a.T_world_base.translation()).norm();
   if (off <= config_.spike_threshold_m || off <= chord) return;

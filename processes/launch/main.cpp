@@ -146,13 +146,17 @@ std::set<std::string> wait_until_ready(const std::string& url, std::set<std::str
 
 }  // namespace
 
+// A stage of the graph, resolved: instance name and the command line that starts it.
+struct Planned {
+  std::string name;
+  std::vector<std::string> argv;
+};
+
 // --offline: each stage reads the previous stage's record (the first reads the input log) with
 // --replay and writes its own with --record: everything the input had plus what the stage
 // published. The last record becomes run.lcmlog; the ones in between are deleted as soon as the
 // next stage has read them. Deterministic: the same input gives the same messages.
-int run_offline(const Options& o,
-                const std::vector<std::pair<std::string, std::vector<std::string>>>& planned,
-                const fs::path& out_dir) {
+int run_offline(const Options& o, const std::vector<Planned>& planned, const fs::path& out_dir) {
   const auto t0 = std::chrono::steady_clock::now();
   Supervisor sup;
   std::string error;
@@ -238,10 +242,6 @@ int main(int argc, char** argv) {
   }
 
   // Resolve every program and config before starting anything.
-  struct Planned {
-    std::string name;
-    std::vector<std::string> argv;
-  };
   std::vector<Planned> planned;
   const std::string logger = find_on_path("lcm-logger"), player = find_on_path("lcm-logplayer");
   const std::string monitor = find_program("traverse-monitor", o.bin_dir);
@@ -287,16 +287,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "run-graph: cannot create %s\n", o.out.c_str());
     return 1;
   }
-  if (o.offline) {
-    struct sigaction sa {};
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
-    std::vector<std::pair<std::string, std::vector<std::string>>> stages_argv;
-    for (const auto& p : planned) stages_argv.emplace_back(p.name, p.argv);
-    return run_offline(o, stages_argv, fs::absolute(o.out));
-  }
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  if (o.offline) return run_offline(o, planned, fs::absolute(o.out));
   std::optional<traverse::launch::PortLease> lease;
   if (o.lcm_url.empty()) {
     lease = traverse::launch::reserve_port(fs::temp_directory_path() / "traverse-lcm-ports", 20000,
@@ -308,13 +305,6 @@ int main(int argc, char** argv) {
     o.lcm_url = traverse::launch::private_url(lease->port(), 8 << 20);
   }
   raise_rmem_max(traverse::launch::recv_buf_size_of(o.lcm_url));
-
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  signal(SIGPIPE, SIG_IGN);
 
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path out_dir = fs::absolute(o.out);

@@ -74,8 +74,7 @@ struct MapperConfig {
   }
 };
 
-// One sweep of the profile scanner as measured (planar_scan_t without the transport fields).
-// A profile of the tilted scanner: the common scan plus its intensities.
+// A profile of the tilted scanner as measured: the common scan plus its intensities.
 struct Profile : PlanarScan {
   std::vector<uint8_t> intensities;  // [0..255], empty or one per range
 };

@@ -23,7 +23,9 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
   if (worker_thread) worker_ = std::thread([this] { run_worker(); });
 }
 
-MapperNode::~MapperNode() {
+MapperNode::~MapperNode() { stop_worker(); }
+
+void MapperNode::stop_worker() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
@@ -87,8 +89,8 @@ void MapperNode::submit(Work work) {
   }
   {
     std::lock_guard lock(mutex_);
+    if (queue_.empty()) oldest_queued_at_ = std::chrono::steady_clock::now();
     queue_.push_back(std::move(work));
-    queued_at_.push_back(std::chrono::steady_clock::now());
     ++submitted_;
     max_queued_ = std::max(max_queued_, queue_.size());
   }
@@ -137,8 +139,7 @@ void MapperNode::run_worker() {
     // Everything queued so far, then the moves once: a loop closure arrives as many segments.
     std::deque<Work> batch;
     batch.swap(queue_);
-    const auto oldest = queued_at_.front();
-    queued_at_.clear();
+    const auto oldest = oldest_queued_at_;
     lock.unlock();
     for (Work& w : batch) apply(w);
     settle();
@@ -161,12 +162,7 @@ void MapperNode::flush() {
 void MapperNode::finish() {
   if (!config_.pose_channel.empty()) cut_segment();
   flush();
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  work_cv_.notify_all();
-  if (worker_.joinable()) worker_.join();
+  stop_worker();
   settle();
 }
 

@@ -75,6 +75,7 @@ class MapperNode {
   void apply(Work& work);  // worker side
   void settle();           // worker side: applies moves, drops stale profiles, takes a snapshot
   void run_worker();
+  void stop_worker();  // lets the worker finish what is queued, then joins it
 
   MapperConfig config_;
   Mapper mapper_;  // touched only by the worker (or inline)
@@ -91,7 +92,7 @@ class MapperNode {
   std::mutex mutex_;
   std::condition_variable work_cv_, idle_cv_;
   std::deque<Work> queue_;
-  std::deque<std::chrono::steady_clock::time_point> queued_at_;  // arrival of each queued item
+  std::chrono::steady_clock::time_point oldest_queued_at_;  // arrival of queue_'s first item
   double lag_s_ = 0.0, lag_max_s_ = 0.0;  // [s] arrival of a batch's oldest item to its settling
   int64_t submitted_ = 0, done_ = 0;
   std::size_t max_queued_ = 0;
