@@ -33,9 +33,11 @@ int main(int argc, char** argv) {
     return traverse::kConfigErrorExitCode;
   }
   if (config.resolution_m <= 0 || config.range_max_m <= config.range_min_m ||
-      config.poses_per_segment < 1) {
-    spdlog::error("{}: need resolution_m > 0, range_max_m > range_min_m, poses_per_segment >= 1",
-                  proc.config_path());
+      config.poses_per_segment < 1 || config.move_threads < 1) {
+    spdlog::error(
+        "{}: need resolution_m > 0, range_max_m > range_min_m, poses_per_segment >= 1, "
+        "move_threads >= 1",
+        proc.config_path());
     return traverse::kConfigErrorExitCode;
   }
   std::signal(SIGUSR1, on_usr1);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <thread>
 
 namespace traverse::mapper {
 
@@ -12,29 +14,60 @@ bool in_footprint(const Footprint& f, const Eigen::Vector3d& p) {
          p.z() >= f.z_min && p.z() <= f.z_max;
 }
 
+// OctoMap's coordToKeyChecked at the finest level, (int)floor(c / resolution) + 32768 within
+// [0, 65536), inlined (the library's is a call per coordinate).
+bool to_key(double c, double scale, uint64_t& key) {
+  const double k = std::floor(scale * c) + 32768.0;
+  if (!(k >= 0.0 && k < 65536.0)) return false;
+  key = static_cast<uint64_t>(k);
+  return true;
+}
+
+octomap::OcTreeKey unpack(uint64_t v) {
+  return octomap::OcTreeKey(static_cast<octomap::key_type>(v & 0xffff),
+                            static_cast<octomap::key_type>((v >> 16) & 0xffff),
+                            static_cast<octomap::key_type>((v >> 32) & 0xffff));
+}
+
 }  // namespace
 
 Mapper::Mapper(const MapperConfig& config, const Eigen::Isometry3d& T_base_laser)
     : config_(config),
       T_base_laser_(T_base_laser),
       range_quantum_m_(config.range_max_m / 65535.0),
-      tree_(std::make_unique<octomap::OcTree>(config.resolution_m)) {}
+      tree_(std::make_unique<octomap::OcTree>(config.resolution_m)) {
+  key_scale_ = 1.0 / tree_->getResolution();  // as OcTree computes its resolution_factor
+}
+
+uint32_t Mapper::beam_table(const Profile& p) {
+  for (std::size_t g = 0; g < beam_tables_.size(); ++g) {
+    const BeamTable& b = beam_tables_[g];
+    if (b.angle_first == p.angle_first && b.angle_step == p.angle_step &&
+        b.dir_base.size() == p.ranges.size()) {
+      return static_cast<uint32_t>(g);
+    }
+  }
+  BeamTable b{p.angle_first, p.angle_step, {}};
+  for (std::size_t i = 0; i < p.ranges.size(); ++i) {
+    const double a = p.angle_first + static_cast<double>(i) * p.angle_step;
+    b.dir_base.push_back(T_base_laser_.linear() * Eigen::Vector3d(std::cos(a), std::sin(a), 0));
+  }
+  beam_tables_.push_back(std::move(b));
+  return static_cast<uint32_t>(beam_tables_.size() - 1);
+}
 
 Mapper::Stored Mapper::compress(const Profile& p) {
   Stored s;
   s.utime_first = p.utime_first;
   s.utime_last = p.utime_last;
-  s.angle_first = p.angle_first;
-  s.angle_step = p.angle_step;
+  s.geometry = beam_table(p);
+  const std::vector<Eigen::Vector3d>& dir = beam_tables_[s.geometry].dir_base;
   s.range_q.assign(p.ranges.size(), 0);
   s.intensity = p.intensities.empty() ? std::vector<uint8_t>(p.ranges.size(), 0) : p.intensities;
   for (std::size_t i = 0; i < p.ranges.size(); ++i) {
     const double r = p.ranges[i];
     if (!std::isfinite(r) || r < config_.range_min_m || r > config_.range_max_m || r <= 0) continue;
-    const double a = p.angle_first + static_cast<double>(i) * p.angle_step;
-    const Eigen::Vector3d p_base =
-        T_base_laser_ * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0);
-    if (in_footprint(config_.footprint, p_base)) {
+    if (in_footprint(config_.footprint, r * dir[i] + T_base_laser_.translation())) {
       ++points_filtered_;
       continue;
     }
@@ -54,52 +87,93 @@ bool Mapper::add_profile(const Profile& p) {
   return true;
 }
 
-bool Mapper::place(const Stored& s, std::vector<Eigen::Vector3f>& pts,
-                   std::vector<int>& beams) const {
+const TrajectorySegment* Mapper::segment_at(int64_t utime, Poses poses) const {
+  const TrajectorySegment* current = trajectory_.segment_at(utime);
+  if (poses == Poses::kBeforeMoves && current) {
+    auto it = before_moves_.find(current->utime_first());
+    if (it != before_moves_.end()) return &it->second;  // same times, the poses before the move
+  }
+  return current;
+}
+
+bool Mapper::place(const Stored& s, std::vector<Eigen::Vector3f>& pts, std::vector<int>& beams,
+                   Poses poses) const {
   pts.clear();
   beams.clear();
   if (!trajectory_.covers(s.utime_first, s.utime_last)) return false;
   const int n = static_cast<int>(s.range_q.size());
   const double dt = static_cast<double>(s.utime_last - s.utime_first) / (n - 1);
-  const Eigen::Matrix3d R_bl = T_base_laser_.linear();
+  const std::vector<Eigen::Vector3d>& dir = beam_tables_[s.geometry].dir_base;
   const Eigen::Vector3d t_bl = T_base_laser_.translation();
   const TrajectorySegment* seg = nullptr;
-  std::size_t j = 1;
+  std::size_t j = 1, interval = 0;  // interval: the j the values below were computed for (0: none)
+  int64_t ta = 0, tb = 0;
+  double xa = 0, ya = 0, dx = 0, dy = 0, ca = 1, sa = 0, dth = 0;
   for (int i = 0; i < n; ++i) {
     if (s.range_q[i] == 0) continue;
     const int64_t t = s.utime_first + std::llround(i * dt);
     // Walk the trajectory forward with the beams (they are in time order).
     if (!seg || t > seg->utime_last()) {
-      seg = trajectory_.segment_at(t);
+      seg = segment_at(t, poses);
       j = 1;
+      interval = 0;
     }
     while (j + 1 < seg->utimes.size() && seg->utimes[j] < t) ++j;
-    const Pose2 T = interpolate_linear(seg->utimes[j - 1], seg->T_world_base[j - 1], seg->utimes[j],
-                                       seg->T_world_base[j], t);
-    const double r = s.range_q[i] * range_quantum_m_;
-    const double a = s.angle_first + static_cast<double>(i) * s.angle_step;
-    const Eigen::Vector3d p_base =
-        R_bl * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0) + t_bl;
-    const double c = std::cos(T.theta()), sn = std::sin(T.theta());
-    pts.emplace_back(static_cast<float>(T.x() + c * p_base.x() - sn * p_base.y()),
-                     static_cast<float>(T.y() + sn * p_base.x() + c * p_base.y()),
+    if (interval != j) {
+      // Pose linear between two trajectory poses: position, and heading the shortest way.
+      const Pose2& a = seg->T_world_base[j - 1];
+      const Pose2& b = seg->T_world_base[j];
+      ta = seg->utimes[j - 1];
+      tb = seg->utimes[j];
+      xa = a.x();
+      ya = a.y();
+      dx = b.x() - a.x();
+      dy = b.y() - a.y();
+      ca = std::cos(a.theta());
+      sa = std::sin(a.theta());
+      dth = wrap_angle(b.theta() - a.theta());
+      interval = j;
+    }
+    const double u = t <= ta ? 0.0 : (t >= tb ? 1.0 : static_cast<double>(t - ta) / (tb - ta));
+    // Rotation by u * dth from heading a; a few mrad between poses 5 ms apart, so a series
+    // (error below d^8 / 40320, under 1e-16 for d < 0.05 rad) instead of a sin and a cos per beam.
+    const double d = u * dth;
+    double cd, sd;
+    if (std::abs(d) < 0.05) {
+      const double d2 = d * d;
+      cd = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30));
+      sd = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42)));
+    } else {
+      cd = std::cos(d);
+      sd = std::sin(d);
+    }
+    const double c = ca * cd - sa * sd, sn = sa * cd + ca * sd;
+    const Eigen::Vector3d p_base = (s.range_q[i] * range_quantum_m_) * dir[i] + t_bl;
+    pts.emplace_back(static_cast<float>(xa + u * dx + c * p_base.x() - sn * p_base.y()),
+                     static_cast<float>(ya + u * dy + sn * p_base.x() + c * p_base.y()),
                      static_cast<float>(p_base.z()));
     beams.push_back(i);
   }
   return true;
 }
 
-octomap::KeySet Mapper::voxel_keys(const Stored& s) const {
-  std::vector<Eigen::Vector3f> pts;
-  std::vector<int> beams;
-  octomap::KeySet keys;
-  if (!place(s, pts, beams)) return keys;
+void Mapper::voxel_keys(const Stored& s, Poses poses, std::vector<uint64_t>& keys) const {
+  thread_local std::vector<Eigen::Vector3f> pts;
+  thread_local std::vector<int> beams;
+  keys.clear();
+  if (!place(s, pts, beams, poses)) return;
   // One hit per voxel per profile, so the counts do not depend on how often a voxel is sampled.
   for (const auto& p : pts) {
-    octomap::OcTreeKey k;
-    if (tree_->coordToKeyChecked(p.x(), p.y(), p.z(), k)) keys.insert(k);
+    uint64_t kx, ky, kz;
+    if (!to_key(p.x(), key_scale_, kx) || !to_key(p.y(), key_scale_, ky) ||
+        !to_key(p.z(), key_scale_, kz)) {
+      continue;
+    }
+    const uint64_t packed = kx | ky << 16 | kz << 32;
+    if (keys.empty() || keys.back() != packed) keys.push_back(packed);  // neighbours often share
   }
-  return keys;
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 }
 
 void Mapper::set_voxel(const octomap::OcTreeKey& key, uint32_t hits) {
@@ -114,7 +188,28 @@ void Mapper::set_voxel(const octomap::OcTreeKey& key, uint32_t hits) {
   tree_->setNodeValue(key, v, true);
 }
 
+void Mapper::add_hit(uint64_t key) {
+  ++hits_[key];
+  touched_.push_back(key);
+}
+
+void Mapper::remove_hit(uint64_t key) {
+  auto it = hits_.find(key);
+  if (it != hits_.end() && --it->second == 0) hits_.erase(it);
+  touched_.push_back(key);
+}
+
+std::pair<std::size_t, std::size_t> Mapper::stored_range(int64_t t0, int64_t t1) const {
+  auto by_first = [](const Stored& x, int64_t t) { return x.utime_first < t; };
+  const auto a = std::lower_bound(stored_.begin(), stored_.end(), t0 - longest_profile_us_, by_first);
+  const auto b = std::upper_bound(stored_.begin(), stored_.end(), t1,
+                                  [](int64_t t, const Stored& x) { return t < x.utime_first; });
+  return {static_cast<std::size_t>(a - stored_.begin()),
+          static_cast<std::size_t>(std::max(a, b) - stored_.begin())};
+}
+
 void Mapper::try_pending() {
+  std::vector<uint64_t> keys;
   for (auto it = pending_.begin(); it != pending_.end();) {
     if (!trajectory_.covers(it->utime_first, it->utime_last)) {
       ++it;
@@ -123,11 +218,21 @@ void Mapper::try_pending() {
     Stored s = std::move(*it);
     it = pending_.erase(it);
     s.key_id = trajectory_.segment_at(s.utime_first)->key_id_first;
-    for (const auto& k : voxel_keys(s)) {
-      ++hits_[k];
-      tree_->updateNode(k, true, true);
+    // A profile spanning a segment whose move is not yet applied goes in with the moves, so that
+    // every profile in the map was placed with the poses before_moves_ keeps.
+    auto moved = before_moves_.upper_bound(s.utime_last);
+    if (moved != before_moves_.begin() && std::prev(moved)->second.utime_last() >= s.utime_first) {
+      s.dirty = true;
+    } else {
+      voxel_keys(s, Poses::kCurrent, keys);
+      for (uint64_t k : keys) {
+        ++hits_[k];
+        tree_->updateNode(unpack(k), true, true);
+      }
+      s.in_map = true;
     }
     points_ += s.n_points;
+    longest_profile_us_ = std::max(longest_profile_us_, s.utime_last - s.utime_first);
     auto pos = std::upper_bound(stored_.begin(), stored_.end(), s.utime_first,
                                 [](int64_t t, const Stored& x) { return t < x.utime_first; });
     stored_.insert(pos, std::move(s));
@@ -135,48 +240,98 @@ void Mapper::try_pending() {
 }
 
 bool Mapper::set_segment(const TrajectorySegment& segment) {
-  if (segment.utimes.empty()) return false;
-  // Profiles placed with the poses this segment replaces lose their hits now (old poses).
-  const int64_t t0 = segment.utimes.front(), t1 = segment.utimes.back();
+  if (!TrajectoryStore::valid(segment)) return false;
+  const int64_t t0 = segment.utime_first();
   const TrajectorySegment* old = trajectory_.segment_at(t0);
-  if (old && old->utime_first() == t0 && old->utimes == segment.utimes &&
-      old->T_world_base.size() == segment.T_world_base.size()) {
-    bool same = true;
-    for (std::size_t i = 0; same && i < segment.T_world_base.size(); ++i) {
-      same = old->T_world_base[i].vector() == segment.T_world_base[i].vector();
-    }
-    if (same) return true;  // sent again unchanged: nothing moves
-  }
   if (old && old->utime_first() == t0) {
-    for (Stored& s : stored_) {
-      if (s.dirty || s.utime_last < t0 || s.utime_first > std::max(t1, old->utime_last())) continue;
-      for (const auto& k : voxel_keys(s)) {
-        if (--hits_[k] == 0) hits_.erase(k);
-        touched_.insert(k);
+    if (old->utimes == segment.utimes) {
+      bool same = true;
+      for (std::size_t i = 0; same && i < segment.T_world_base.size(); ++i) {
+        same = old->T_world_base[i].vector() == segment.T_world_base[i].vector();
       }
-      s.dirty = true;
+      if (same) return true;  // sent again unchanged: nothing moves
+      // Moved: its profiles are placed again at apply_moves(), with these poses and the ones
+      // they were placed with (kept from the first move since the last apply_moves()).
+      before_moves_.try_emplace(t0, *old);
+      const auto [a, b] = stored_range(t0, old->utime_last());
+      for (std::size_t i = a; i < b; ++i) {
+        if (stored_[i].utime_last >= t0) stored_[i].dirty = true;
+      }
+    } else {
+      // Other times (not sent by the densifier, whose segments run between fixed key poses):
+      // the profiles it spans leave the map now, with the poses they were placed with.
+      std::vector<uint64_t> keys;
+      const auto [a, b] = stored_range(t0, std::max(segment.utime_last(), old->utime_last()));
+      for (std::size_t i = a; i < b; ++i) {
+        Stored& s = stored_[i];
+        if (s.utime_last < t0) continue;
+        if (s.in_map) {
+          voxel_keys(s, Poses::kBeforeMoves, keys);
+          for (uint64_t k : keys) remove_hit(k);
+          s.in_map = false;
+        }
+        s.dirty = true;
+      }
+      before_moves_.erase(t0);
     }
   }
-  if (!trajectory_.set(segment)) return false;
+  trajectory_.set(segment);
   try_pending();
   return true;
 }
 
+void Mapper::change(const Stored& s, Change& c) const {
+  thread_local std::vector<uint64_t> before, after;
+  c.left.clear();
+  c.entered.clear();
+  voxel_keys(s, Poses::kCurrent, after);
+  if (!s.in_map) {
+    c.entered = after;
+    return;
+  }
+  voxel_keys(s, Poses::kBeforeMoves, before);
+  std::set_difference(before.begin(), before.end(), after.begin(), after.end(),
+                      std::back_inserter(c.left));
+  std::set_difference(after.begin(), after.end(), before.begin(), before.end(),
+                      std::back_inserter(c.entered));
+}
+
 std::size_t Mapper::apply_moves() {
+  std::vector<std::size_t> dirty;
+  for (std::size_t i = 0; i < stored_.size(); ++i) {
+    if (stored_[i].dirty) dirty.push_back(i);
+  }
+  // Blocks of profiles: the changes are found on move_threads threads, then counted in profile
+  // order on this one (the same result for any number of threads).
+  constexpr std::size_t kBlock = 256;
+  std::vector<Change> changes(std::min(kBlock, dirty.size()));
+  const std::size_t threads = static_cast<std::size_t>(std::max(1, config_.move_threads));
   std::size_t moved = 0;
-  for (Stored& s : stored_) {
-    if (!s.dirty) continue;
-    s.dirty = false;
-    ++moved;
-    s.key_id = trajectory_.segment_at(s.utime_first)->key_id_first;
-    for (const auto& k : voxel_keys(s)) {
-      ++hits_[k];
-      touched_.insert(k);
+  for (std::size_t b0 = 0; b0 < dirty.size(); b0 += kBlock) {
+    const std::size_t n = std::min(kBlock, dirty.size() - b0);
+    auto work = [&](std::size_t first) {
+      for (std::size_t i = first; i < n; i += threads) change(stored_[dirty[b0 + i]], changes[i]);
+    };
+    std::vector<std::thread> helpers;
+    for (std::size_t t = 1; t < threads && t < n; ++t) helpers.emplace_back(work, t);
+    work(0);
+    for (auto& h : helpers) h.join();
+    for (std::size_t i = 0; i < n; ++i) {
+      Stored& s = stored_[dirty[b0 + i]];
+      if (s.in_map) ++moved;
+      for (uint64_t k : changes[i].left) remove_hit(k);
+      for (uint64_t k : changes[i].entered) add_hit(k);
+      s.key_id = trajectory_.segment_at(s.utime_first)->key_id_first;
+      s.dirty = false;
+      s.in_map = true;
     }
   }
-  for (const auto& k : touched_) {
+  before_moves_.clear();
+  std::sort(touched_.begin(), touched_.end());
+  touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
+  for (uint64_t k : touched_) {
     auto it = hits_.find(k);
-    set_voxel(k, it == hits_.end() ? 0 : it->second);
+    set_voxel(unpack(k), it == hits_.end() ? 0 : it->second);
   }
   touched_.clear();
   profiles_replaced_ += static_cast<int64_t>(moved);

@@ -7,11 +7,13 @@
 // take back an insertion. So the mapper keeps every profile as it was measured (ranges quantised
 // to 16 bits and 8-bit intensities, 3 bytes per beam: ~0.73 MB/s at 244,000 points/s, ~1.3 GB for
 // a 30-minute session) and, per occupied voxel, how many profiles hit it (grows with the mapped
-// surface, not with time, like the OctoMap). When a segment moves, its profiles' hits are taken
-// out of the counts with the old poses and put back with the new ones, and exactly the voxels
-// whose count changed are set again in the OctoMap. A voxel no profile hits any more becomes
-// free (OctoMap 1.9's deleteNode aborts when a deletion empties an inner node, so nodes are
-// never deleted).
+// surface, not with time, like the OctoMap). When a segment moves, the version its profiles were
+// placed with is kept until the next apply_moves(), which places each such profile with the old
+// and with the new poses and changes the counts of only the voxels the profile left or entered
+// (a loop closure of a few millimetres leaves most of a profile's 2 cm voxels where they were).
+// Exactly the voxels whose count changed are set again in the OctoMap. A voxel no profile hits any
+// more becomes free (OctoMap 1.9's deleteNode aborts when a deletion empties an inner node, so
+// nodes are never deleted).
 //
 // The OctoMap holds the occupied voxels of the points (each profile counts one hit per voxel);
 // free space is not carved: casting each 6 m ray through 2 cm voxels would cost ~300 updates per
@@ -24,6 +26,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -60,6 +63,7 @@ struct MapperConfig {
   std::string pose_channel;     // "": DENSE_SEGMENTS from the densifier; else pose2d_t stream
   int poses_per_segment = 40;   // segment length when reading a pose2d_t stream
   double max_pending_s = 30.0;  // [s] profiles waiting longer for poses are dropped
+  int move_threads = 2;         // threads that place moved profiles again (counts: one thread)
   template <class V>
   void visit(V& v) {
     v("resolution_m", resolution_m);
@@ -71,6 +75,7 @@ struct MapperConfig {
     v("pose_channel", pose_channel);
     v("poses_per_segment", poses_per_segment);
     v("max_pending_s", max_pending_s);
+    v("move_threads", move_threads);
   }
 };
 
@@ -94,7 +99,8 @@ class Mapper {
   // malformed (sizes, times).
   bool add_profile(const Profile& profile);
   // Stores a trajectory segment. A new segment places waiting profiles; a moved one marks the
-  // profiles it spans for re-placement at the next apply_moves().
+  // profiles it spans for re-placement at the next apply_moves(). Profiles placed while a segment
+  // they span has moved and the move is not yet applied go into the map at apply_moves().
   bool set_segment(const TrajectorySegment& segment);
   // Re-places moved profiles and updates the voxels whose hit count changed. Returns their number.
   std::size_t apply_moves();
@@ -121,31 +127,59 @@ class Mapper {
  private:
   struct Stored {
     int64_t utime_first = 0, utime_last = 0;
-    float angle_first = 0, angle_step = 0;
+    uint32_t geometry = 0;          // index into beam_tables_
     std::vector<uint16_t> range_q;  // quantised range, 0 = no point
     std::vector<uint8_t> intensity;
     int64_t key_id = 0;
     int32_t n_points = 0;
-    bool dirty = false;  // its segment moved: hits taken out, to be placed again
+    bool dirty = false;   // its poses changed: to be placed again at apply_moves()
+    bool in_map = false;  // its hits are in hits_ (placed with the poses it had before a move)
   };
+  // Unit beam directions in the base frame of one scan geometry (all profiles of a scanner share
+  // one), so placing a point needs no trigonometry per beam.
+  struct BeamTable {
+    double angle_first = 0, angle_step = 0;  // [rad]
+    std::vector<Eigen::Vector3d> dir_base;
+  };
+  // Which segment versions to place a profile with: the current ones, or those it was placed with.
+  enum class Poses { kCurrent, kBeforeMoves };
   Stored compress(const Profile& p);
+  uint32_t beam_table(const Profile& p);
   // World points of a stored profile (and their beam indices); false if poses are missing.
-  bool place(const Stored& s, std::vector<Eigen::Vector3f>& pts, std::vector<int>& beams) const;
-  // Distinct voxels hit by a stored profile at its current place.
-  octomap::KeySet voxel_keys(const Stored& s) const;
+  bool place(const Stored& s, std::vector<Eigen::Vector3f>& pts, std::vector<int>& beams,
+             Poses poses = Poses::kCurrent) const;
+  // Distinct voxels hit by a stored profile, as packed keys, sorted.
+  void voxel_keys(const Stored& s, Poses poses, std::vector<uint64_t>& keys) const;
+  // Voxels a dirty profile leaves and enters when placed with the current poses.
+  struct Change {
+    std::vector<uint64_t> left, entered;
+  };
+  void change(const Stored& s, Change& c) const;
+  // Segment covering `utime` in the given version; nullptr if none.
+  const TrajectorySegment* segment_at(int64_t utime, Poses poses) const;
+  // Stored profiles that may overlap [t0, t1]: [first, last).
+  std::pair<std::size_t, std::size_t> stored_range(int64_t t0, int64_t t1) const;
   // Sets a voxel's log-odds to what `hits` profile hits give (free when none).
   void set_voxel(const octomap::OcTreeKey& key, uint32_t hits);
+  void add_hit(uint64_t key);
+  void remove_hit(uint64_t key);
   void try_pending();
 
   MapperConfig config_;
   Eigen::Isometry3d T_base_laser_;
   double range_quantum_m_;
+  double key_scale_;  // [1/m] OctoMap's resolution factor
   TrajectoryStore trajectory_;
   std::unique_ptr<octomap::OcTree> tree_;
+  std::vector<BeamTable> beam_tables_;
+  // Segments as they were before the moves not yet applied, by first time (the version their
+  // in-map profiles were placed with).
+  std::map<int64_t, TrajectorySegment> before_moves_;
   std::deque<Stored> pending_;
   std::vector<Stored> stored_;  // by utime_first
-  std::unordered_map<octomap::OcTreeKey, uint32_t, octomap::OcTreeKey::KeyHash> hits_;
-  octomap::KeySet touched_;  // voxels whose hit count changed since the last apply_moves
+  int64_t longest_profile_us_ = 0;
+  std::unordered_map<uint64_t, uint32_t> hits_;  // profiles hitting each voxel, by packed key
+  std::vector<uint64_t> touched_;  // voxels whose hit count changed since the last apply_moves
   int64_t points_ = 0, points_filtered_ = 0, profiles_replaced_ = 0;
 };
 

@@ -12,12 +12,14 @@ Pose2 interpolate_linear(int64_t t0, const Pose2& a, int64_t t1, const Pose2& b,
   return Pose2(t.x(), t.y(), wrap_angle(a.theta() + s * wrap_angle(b.theta() - a.theta())));
 }
 
+bool TrajectoryStore::valid(const TrajectorySegment& segment) {
+  return segment.utimes.size() >= 2 && segment.utimes.size() == segment.T_world_base.size() &&
+         std::is_sorted(segment.utimes.begin(), segment.utimes.end()) &&
+         segment.utimes.front() != segment.utimes.back();
+}
+
 bool TrajectoryStore::set(TrajectorySegment segment, bool* replaced) {
-  if (segment.utimes.size() < 2 || segment.utimes.size() != segment.T_world_base.size() ||
-      !std::is_sorted(segment.utimes.begin(), segment.utimes.end()) ||
-      segment.utimes.front() == segment.utimes.back()) {
-    return false;
-  }
+  if (!valid(segment)) return false;
   const int64_t t0 = segment.utime_first();
   auto it = segments_.find(t0);
   if (replaced) *replaced = it != segments_.end();

@@ -25,6 +25,8 @@ class TrajectoryStore {
   // Stores or replaces the segment starting at its first time; false if it has fewer than two
   // poses or unsorted times. `replaced` tells whether a segment with that start existed.
   bool set(TrajectorySegment segment, bool* replaced = nullptr);
+  // What set() accepts: at least two poses, one per time, times increasing.
+  static bool valid(const TrajectorySegment& segment);
 
   // Pose at `utime`, nullopt when no segment covers it.
   std::optional<Pose2> pose_at(int64_t utime) const;

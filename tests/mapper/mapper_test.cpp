@@ -1,6 +1,7 @@
 // Mapper: each point is placed with the pose at its own time and the scanner extrinsic; range and
-// footprint filters; profiles wait for poses; a moved segment gives the same cloud and OctoMap as
-// a map built from scratch with the final trajectory; PLY round trip.
+// footprint filters; profiles wait for poses; moved segments (large or small, repeated, with
+// profiles arriving between the moves) give the same cloud and OctoMap as a map built from
+// scratch with the final trajectory; PLY round trip.
 #include "mapper.hpp"
 
 #include <gtest/gtest.h>
@@ -136,6 +137,92 @@ TEST(Mapper, MovedSegmentsGiveTheSameMapAsAFreshBuild) {
   EXPECT_GT(b.size(), 500u);
   EXPECT_EQ(a, b);
   EXPECT_EQ(moved.occupied_voxels(), fresh.occupied_voxels());
+  EXPECT_EQ(moved.occupied_voxels(), b.size());
+  std::vector<CloudPoint> pa, pb;
+  moved.for_each_point([&](const CloudPoint& p) { pa.push_back(p); });
+  fresh.for_each_point([&](const CloudPoint& p) { pb.push_back(p); });
+  ASSERT_EQ(pa.size(), pb.size());
+  for (std::size_t i = 0; i < pa.size(); ++i) {
+    EXPECT_EQ(pa[i].p_world, pb[i].p_world);
+    EXPECT_EQ(pa[i].key_id, pb[i].key_id);
+  }
+}
+
+TEST(Mapper, VoxelsAreOctoMapsKeysOfThePoints) {
+  // The mapper computes voxel keys itself (inline); they must be OctoMap's own.
+  MapperConfig c = small_footprint();
+  c.resolution_m = 0.03;
+  Mapper m(c, tilted_extrinsic());
+  m.set_segment(segment(0));
+  m.add_profile(profile(kT0 + 20'000));
+  std::map<std::tuple<int, int, int>, float> expected;
+  const float one_hit = m.octree().getProbHitLog();
+  m.for_each_point([&](const CloudPoint& p) {
+    octomap::OcTreeKey k;
+    ASSERT_TRUE(m.octree().coordToKeyChecked(p.p_world.x(), p.p_world.y(), p.p_world.z(), k));
+    expected[{k[0], k[1], k[2]}] = one_hit;
+  });
+  EXPECT_GT(expected.size(), 100u);
+  EXPECT_EQ(leaves(m.octree()), expected);
+}
+
+// Segment k moved by dy [m] and turned by dth [rad].
+TrajectorySegment shifted(int k, double dy, double dth) {
+  TrajectorySegment s = segment(k);
+  for (Pose2& T : s.T_world_base) T = Pose2(T.x(), T.y() + dy, T.theta() + dth);
+  return s;
+}
+
+// Segment k with other times: poses every 20 ms, 4 mm aside.
+TrajectorySegment coarse(int k) {
+  TrajectorySegment s;
+  s.key_id_first = k;
+  for (int i = 0; i <= 5; ++i) {
+    const int64_t t = kT0 + (k * 10 + 2 * i) * 10'000;
+    s.utimes.push_back(t);
+    s.T_world_base.push_back(truth(t, 0.004));
+  }
+  return s;
+}
+
+TEST(Mapper, RepeatedSmallMovesGiveTheSameMapAsAFreshBuild) {
+  // Millimetre moves at 2 cm leave most voxels of a profile where they were: only those left or
+  // entered change. Segments move twice before the moves are applied, a profile arrives between
+  // two moves of its segment, new segments arrive meanwhile, and one segment comes with other
+  // times; the map must equal one built from scratch with the final trajectory.
+  MapperConfig c = small_footprint();
+  Mapper moved(c, tilted_extrinsic()), fresh(c, tilted_extrinsic());
+  std::vector<int64_t> times;
+  for (int64_t t = kT0; t + 33'000 <= kT0 + 600'000; t += 33'333) times.push_back(t);
+  const int64_t late = kT0 + 215'000;  // inside segment 2
+  for (int k = 0; k < 4; ++k) moved.set_segment(segment(k));
+  for (int64_t t : times) moved.add_profile(profile(t));
+  EXPECT_EQ(moved.pending(), 6u);  // those after 400 ms wait for segments 4 and 5
+  moved.set_segment(shifted(1, 0.0015, 0.0));
+  moved.set_segment(shifted(2, 0.001, 2e-4));
+  moved.add_profile(profile(late));
+  moved.set_segment(shifted(1, 0.003, -1e-4));
+  moved.set_segment(shifted(2, 0.002, 3e-4));
+  moved.set_segment(segment(4));
+  moved.set_segment(segment(5));
+  EXPECT_EQ(moved.pending(), 0u);
+  EXPECT_GE(moved.apply_moves(), 6u);  // profiles placed before the moves in segments 1 and 2
+  moved.set_segment(coarse(3));
+  moved.set_segment(segment(1));
+  moved.apply_moves();
+
+  fresh.set_segment(segment(0));
+  fresh.set_segment(segment(1));
+  fresh.set_segment(shifted(2, 0.002, 3e-4));
+  fresh.set_segment(coarse(3));
+  fresh.set_segment(segment(4));
+  fresh.set_segment(segment(5));
+  for (int64_t t : times) fresh.add_profile(profile(t));
+  fresh.add_profile(profile(late));
+  EXPECT_EQ(moved.profiles(), fresh.profiles());
+  const auto a = leaves(moved.octree()), b = leaves(fresh.octree());
+  EXPECT_GT(b.size(), 2000u);
+  EXPECT_EQ(a, b);
   EXPECT_EQ(moved.occupied_voxels(), b.size());
   std::vector<CloudPoint> pa, pb;
   moved.for_each_point([&](const CloudPoint& p) { pa.push_back(p); });
