@@ -2,14 +2,29 @@
 // decode is counted and dropped; one whose utime goes backwards is counted and dropped; skipped
 // sequence numbers are counted; a handler that throws is reported and counted, and the process
 // keeps running.
+//
+// On a network bus (udpm://) a receive thread reads the socket all the time and queues what
+// arrives in memory; handle() dispatches the queued messages, in order, on the calling thread,
+// where every handler runs. A process busy for seconds (a loop closure, an optimisation) so loses
+// nothing to its socket's receive buffer: every process's socket gets every channel of the group,
+// and net.core.rmem_max (8 MB here) holds about two seconds of a whole graph's traffic. Messages
+// beyond max_queued_bytes are dropped and counted. On memq:// (in process) there is no socket:
+// handle() dispatches as LCM delivers, on the calling thread.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
 #include <functional>
 #include <list>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "publisher.hpp"
 
@@ -31,27 +46,43 @@ class Bus : public Publisher {
   template <class T>
   void subscribe(const std::string& channel, std::function<void(const T&)> handler,
                  bool accept_out_of_order = false) {
-    auto sub = std::make_unique<Subscription>();
-    sub->bus = this;
-    sub->dispatch = [this, channel, accept_out_of_order, handler = std::move(handler)](
-                        const void* data, int size) {
-      T msg;
-      if (msg.decode(data, 0, size) != size) return Outcome::kDecodeFailure;
-      int64_t seq = -1;
-      if constexpr (requires { msg.seq; }) seq = msg.seq;
-      if (!admit(channel, msg.utime, seq, accept_out_of_order)) return Outcome::kOutOfOrder;
-      handler(msg);
-      return Outcome::kHandled;
-    };
-    lcm_.subscribe(channel, &Subscription::on_message, sub.get());
+    add_subscription(channel, true,
+                     [this, channel, accept_out_of_order, handler = std::move(handler)](
+                         const std::string&, const uint8_t* data, int size, int64_t) {
+                       T msg;
+                       if (msg.decode(data, 0, size) != size) return Outcome::kDecodeFailure;
+                       int64_t seq = -1;
+                       if constexpr (requires { msg.seq; }) seq = msg.seq;
+                       if (!admit(channel, msg.utime, seq, accept_out_of_order)) {
+                         return Outcome::kOutOfOrder;
+                       }
+                       handler(msg);
+                       return Outcome::kHandled;
+                     });
     stats_[channel];  // list the channel in status even before the first message
-    subscriptions_.push_back(std::move(sub));
   }
+
+  // Raw bytes of every message on channels matching `channel_regex`, with the time the bus
+  // received each [us]; `handler(channel, data, size, recv_utime)`. Not counted per channel.
+  // The handle ends the subscription with unsubscribe().
+  using RawHandler = std::function<void(const std::string& channel, const uint8_t* data, int size,
+                                        int64_t recv_utime)>;
+  using Handle = const void*;
+  Handle subscribe_raw(const std::string& channel_regex, RawHandler handler);
+  // No message reaches the handler afterwards (also none already received).
+  void unsubscribe(Handle handle);
 
   // Waits up to timeout_ms for messages and dispatches them. Returns false on an LCM error.
   bool handle(int timeout_ms);
 
+  // Receive queue of a network bus: largest size reached [bytes] and messages dropped because it
+  // was full (both 0 on memq://).
+  int64_t queue_max_bytes() const;
+  int64_t queue_dropped() const;
+  static constexpr int64_t kMaxQueuedBytes = int64_t{1} << 30;
+
   lcm::LCM& lcm() { return lcm_; }
+  ~Bus() override;
 
  protected:
   void send(const std::string& channel, const uint8_t* data, std::size_t size,
@@ -59,18 +90,41 @@ class Bus : public Publisher {
 
  private:
   enum class Outcome { kHandled, kDecodeFailure, kOutOfOrder };
+  using Dispatch = std::function<Outcome(const std::string& channel, const uint8_t*, int, int64_t)>;
   struct Subscription {
     Bus* bus = nullptr;
-    std::function<Outcome(const void*, int)> dispatch;
+    bool counted = true;  // typed: decode failures and handler errors go into the channel's stats
+    std::atomic<bool> active{true};  // kept until the bus ends: the receive thread may hold it
+    lcm::Subscription* lcm_subscription = nullptr;
+    Dispatch dispatch;
     void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   };
+  struct Received {
+    Subscription* subscription = nullptr;
+    std::string channel;
+    std::vector<uint8_t> data;
+    int64_t recv_utime = 0;
+  };
 
+  Subscription* add_subscription(const std::string& channel, bool counted, Dispatch dispatch);
+  // Runs a subscription's handler on one message (on the thread that calls handle()).
+  void deliver(Subscription& sub, const std::string& channel, const uint8_t* data, int size,
+               int64_t recv_utime);
+  void read_loop();  // the receive thread of a network bus
   // Updates sequence and order counters; false if the message must be dropped.
   bool admit(const std::string& channel, int64_t utime, int64_t seq, bool accept_out_of_order);
 
   std::string url_;
   lcm::LCM lcm_;
   std::list<std::unique_ptr<Subscription>> subscriptions_;
+  const bool threaded_;  // network bus: a receive thread queues messages
+  std::thread reader_;   // started by the first handle()
+  mutable std::mutex mutex_;
+  std::condition_variable arrived_;
+  std::deque<Received> queue_;
+  int64_t queued_bytes_ = 0, queue_max_bytes_ = 0, queue_dropped_ = 0;
+  bool read_failed_ = false;
+  std::atomic<bool> stop_reading_{false};
 };
 
 }  // namespace traverse

@@ -229,6 +229,11 @@ void Process::publish_status(const std::string& state) {
     st.counter_names.push_back(k);
     st.counter_values.push_back(v);
   }
+  // The bus's receive queue (network bus): how far handling fell behind, and what it dropped.
+  st.counter_names.push_back("receive_queue_max_bytes");
+  st.counter_values.push_back(static_cast<double>(bus_->queue_max_bytes()));
+  st.counter_names.push_back("receive_queue_dropped");
+  st.counter_values.push_back(static_cast<double>(bus_->queue_dropped()));
   st.n_counters = static_cast<int32_t>(st.counter_names.size());
   bus_->publish(channels::status_channel(name_), st);
 }

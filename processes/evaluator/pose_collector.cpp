@@ -181,15 +181,12 @@ std::size_t PoseCollector::estimate_size() const {
   return pose2d_estimate_.size();
 }
 
-void PoseCollector::on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  on_event(channel, rbuf->data, static_cast<int>(rbuf->data_size));
-}
-
 void PoseCollector::subscribe(Bus& bus) {
   // Raw subscriptions: the type is decided per message from its fingerprint, exactly as offline.
   std::set<std::string> channels = {estimate_channel_, reference_channel_, key_poses_channel_};
   for (const std::string& channel : channels) {
-    bus.lcm().subscribe(channel, &PoseCollector::on_lcm, this);
+    bus.subscribe_raw(channel, [this](const std::string& ch, const uint8_t* data, int size,
+                                      int64_t) { on_event(ch, data, size); });
   }
 }
 

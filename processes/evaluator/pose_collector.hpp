@@ -65,7 +65,6 @@ class PoseCollector {
   const std::set<std::string>& estimate_types_seen() const { return estimate_types_seen_; }
 
  private:
-  void on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void add_estimate(const std::string& type_name, const void* data, int size);
   void add_reference(const std::string& type_name, const void* data, int size);
   void add_closures(const void* data, int size);

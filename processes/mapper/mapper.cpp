@@ -201,7 +201,8 @@ void Mapper::remove_hit(uint64_t key) {
 
 std::pair<std::size_t, std::size_t> Mapper::stored_range(int64_t t0, int64_t t1) const {
   auto by_first = [](const Stored& x, int64_t t) { return x.utime_first < t; };
-  const auto a = std::lower_bound(stored_.begin(), stored_.end(), t0 - longest_profile_us_, by_first);
+  const auto a =
+      std::lower_bound(stored_.begin(), stored_.end(), t0 - longest_profile_us_, by_first);
   const auto b = std::upper_bound(stored_.begin(), stored_.end(), t1,
                                   [](int64_t t, const Stored& x) { return t < x.utime_first; });
   return {static_cast<std::size_t>(a - stored_.begin()),

@@ -36,22 +36,25 @@ validate::ProcessReport to_report(const process_status_t& st) {
 
 MonitorNode::MonitorNode(Bus& bus, const MonitorConfig& cfg)
     : bus_(bus), tracker_(cfg.status_timeout_s), start_utime_(now_utime()) {
-  subscription_ = bus_.lcm().subscribe(".*", &MonitorNode::on_message, this);
+  subscription_ = bus_.subscribe_raw(
+      ".*", [this](const std::string& channel, const uint8_t* data, int size, int64_t recv_utime) {
+        on_message(channel, data, size, recv_utime);
+      });
 }
 
 MonitorNode::~MonitorNode() {
-  if (subscription_) bus_.lcm().unsubscribe(subscription_);
+  if (subscription_) bus_.unsubscribe(subscription_);
 }
 
-void MonitorNode::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void MonitorNode::on_message(const std::string& channel, const uint8_t* data, int size,
+                             int64_t recv_utime) {
   if (channel == channels::kLcmSelfTest) return;
-  analyzer_.add(channel, rbuf->recv_utime, rbuf->data, rbuf->data_size);
+  analyzer_.add(channel, recv_utime, data, static_cast<std::size_t>(size));
   if (channel.rfind(kStatusPrefix, 0) != 0) return;
   process_status_t st;
   bool ok = false;
   try {
-    ok = st.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) ==
-         static_cast<int>(rbuf->data_size);
+    ok = st.decode(data, 0, size) == size;
   } catch (const std::exception&) {
     ok = false;  // corrupt array lengths make the generated decoder throw
   }
@@ -59,7 +62,7 @@ void MonitorNode::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& 
     ++status_decode_failures_;
     return;
   }
-  tracker_.add(channel, rbuf->recv_utime, to_report(st));
+  tracker_.add(channel, recv_utime, to_report(st));
 }
 
 validate::RunSummary MonitorNode::summary(int64_t now_utime) const {

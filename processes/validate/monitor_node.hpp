@@ -36,10 +36,10 @@ class MonitorNode {
   int64_t events() const { return analyzer_.events(); }
 
  private:
-  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_message(const std::string& channel, const uint8_t* data, int size, int64_t recv_utime);
 
   Bus& bus_;
-  lcm::Subscription* subscription_ = nullptr;
+  Bus::Handle subscription_ = nullptr;
   validate::StreamAnalyzer analyzer_;
   validate::ProcessTracker tracker_;
   int64_t start_utime_ = 0;

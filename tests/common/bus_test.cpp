@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <stdexcept>
+#include <thread>
 
 #include "traverse/imu_t.hpp"
+#include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
 
 namespace traverse {
@@ -91,6 +95,51 @@ TEST(Bus, HandlerThatThrowsIsCountedAndLaterMessagesStillFlow) {
   }
   EXPECT_EQ(handled, 2);
   EXPECT_EQ(bus.stats().at("POSE").handler_errors, 1);
+}
+
+TEST(Bus, NetworkBusQueuesWhatArrivesWhileAHandlerIsBusy) {
+  // A private multicast port; the receiver's socket buffer is 1 MB (the kernel doubles it). Its
+  // handler blocks for 3 s on the first message while 8 MB more arrive: more than the socket
+  // holds, so only the receive thread, queueing as they come, keeps every one of them.
+  const std::string url = "udpm://239.255.76.67:31397?ttl=0&recv_buf_size=1048576";
+  Bus sender(url), receiver(url);
+  ASSERT_TRUE(sender.good() && receiver.good());
+  constexpr int kMessages = 81;
+  std::vector<int64_t> seqs;
+  std::atomic<bool> blocked{false};
+  receiver.subscribe<planar_scan_t>("SCAN", [&](const planar_scan_t& m) {
+    seqs.push_back(m.seq);
+    if (seqs.size() == 1) {
+      blocked = true;
+      std::this_thread::sleep_for(std::chrono::seconds(3));
+    }
+  });
+  ASSERT_TRUE(receiver.handle(0));  // starts the receive thread
+  std::thread handling([&] {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (seqs.size() < kMessages && std::chrono::steady_clock::now() < deadline) {
+      receiver.handle(100);
+    }
+  });
+  planar_scan_t scan{};
+  scan.frame = "laser";
+  scan.n_ranges = 25'000;  // 100 KB
+  scan.ranges.assign(scan.n_ranges, 1.0f);
+  for (int i = 0; i < kMessages; ++i) {
+    scan.utime = 1000 + i;
+    sender.publish("SCAN", scan);
+    if (i == 0) {
+      while (!blocked) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // 5 MB/s
+    }
+  }
+  handling.join();
+  ASSERT_EQ(seqs.size(), static_cast<std::size_t>(kMessages));
+  for (int i = 0; i < kMessages; ++i) EXPECT_EQ(seqs[i], i);
+  EXPECT_EQ(receiver.stats().at("SCAN").missed, 0);
+  EXPECT_EQ(receiver.queue_dropped(), 0);
+  EXPECT_GT(receiver.queue_max_bytes(), 4'000'000);  // queued beyond what the socket holds
 }
 
 }  // namespace
