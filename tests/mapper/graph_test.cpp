@@ -2,14 +2,19 @@
 // key poses, the corrected trajectory reaches the mapper as segments, profiles are placed with it,
 // and a re-optimisation republishes only the moved segments and moves the mapper's points.
 #include <gtest/gtest.h>
+#include <octomap/AbstractOcTree.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <numbers>
 
 #include "channels.hpp"
 #include "densifier_node.hpp"
 #include "mapper_node.hpp"
+#include "ply.hpp"
 
 namespace traverse {
 namespace {
@@ -24,6 +29,9 @@ class GraphTest : public ::testing::TestWithParam<bool> {
   void SetUp() override {
     mapper::MapperConfig mc;
     mc.footprint = {-0.1, 0.1, -0.1, 0.1, 0.02, 0.5};
+    out_dir_ = std::filesystem::temp_directory_path() /
+               ("traverse_graph_test_" + std::to_string(::getpid()) + (GetParam() ? "_w" : "_i"));
+    mc.output_dir = out_dir_.string();
     Eigen::Isometry3d T_base_laser = Eigen::Isometry3d::Identity();
     T_base_laser.linear() =
         Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -92,7 +100,10 @@ class GraphTest : public ::testing::TestWithParam<bool> {
     }
   }
 
+  void TearDown() override { std::filesystem::remove_all(out_dir_); }
+
   Bus bus_{"memq://"};
+  std::filesystem::path out_dir_;
   std::unique_ptr<densifier::DensifierNode> densifier_;
   std::unique_ptr<mapper::MapperNode> mapper_;
   std::vector<dense_segments_t> messages_;
@@ -195,6 +206,49 @@ TEST_P(GraphTest, BurstOfMovedSegmentsGoesOutInFewWholeMessages) {
   mapper_->report_counters();
   EXPECT_EQ(mapper_counters_["segments_applied"], 2 * kSegments);
   EXPECT_EQ(mapper_counters_["segments_stale"], again.n_segments);
+}
+
+// Occupied leaves of `a` that are not occupied in `b` (by key at the finest level).
+int occupied_missing(const octomap::OcTree& a, const octomap::OcTree& b) {
+  int missing = 0;
+  for (auto it = a.begin_leafs(), end = a.end_leafs(); it != end; ++it) {
+    if (!a.isNodeOccupied(*it)) continue;
+    const octomap::OcTreeNode* n = b.search(it.getCoordinate());
+    if (!n || !b.isNodeOccupied(n)) ++missing;
+  }
+  return missing;
+}
+
+// The exports after a move: the PLY reads back point for point, and OctoMap's own tool
+// (convert_octree of octomap-tools) reads map.bt and map.ot into the same occupied voxels.
+TEST_P(GraphTest, ExportsReadBackThroughThePlyReaderAndOctoMapsOwnTool) {
+  drive(100, true);
+  send_keys({5, 6}, 0.05);
+  handle_all();
+  mapper_->flush();
+  std::string error;
+  ASSERT_TRUE(mapper_->export_all(&error)) << error;
+  const mapper::Mapper& m = mapper_->mapper();
+  auto cloud = mapper::read_ply((out_dir_ / "cloud.ply").string(), &error);
+  ASSERT_TRUE(cloud) << error;
+  ASSERT_EQ(static_cast<int64_t>(cloud->size()), m.placed_points());
+  std::size_t i = 0;
+  m.for_each_point(
+      [&](const mapper::CloudPoint& p) { EXPECT_EQ((*cloud)[i++].p_world, p.p_world); });
+  EXPECT_GT(m.occupied_voxels(), 100u);
+  for (const std::string name : {"map.bt", "map.ot"}) {
+    const auto converted = out_dir_ / (name + ".converted.ot");
+    const std::string cmd = "convert_octree " + (out_dir_ / name).string() + " " +
+                            converted.string() + " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << " (octomap-tools: scripts/setup.sh)";
+    std::unique_ptr<octomap::AbstractOcTree> read(
+        octomap::AbstractOcTree::read(converted.string()));
+    const auto* tree = dynamic_cast<const octomap::OcTree*>(read.get());
+    ASSERT_NE(tree, nullptr) << converted;
+    EXPECT_EQ(tree->getResolution(), m.octree().getResolution());
+    EXPECT_EQ(occupied_missing(m.octree(), *tree), 0) << name;
+    EXPECT_EQ(occupied_missing(*tree, m.octree()), 0) << name;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),
