@@ -8,8 +8,8 @@
 // where every handler runs. A process busy for seconds (a loop closure, an optimisation) so loses
 // nothing to its socket's receive buffer: every process's socket gets every channel of the group,
 // and net.core.rmem_max (8 MB here) holds about two seconds of a whole graph's traffic. Messages
-// beyond max_queued_bytes are dropped and counted. On memq:// (in process) there is no socket:
-// handle() dispatches as LCM delivers, on the calling thread.
+// beyond kMaxQueuedBytes (1 GiB) queued are dropped and counted. On memq:// (in process) there
+// is no socket: handle() dispatches as LCM delivers, on the calling thread.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>

@@ -136,7 +136,7 @@ bool Mapper::place(const Stored& s, std::vector<Eigen::Vector3f>& pts, std::vect
     }
     const double u = t <= ta ? 0.0 : (t >= tb ? 1.0 : static_cast<double>(t - ta) / (tb - ta));
     // Rotation by u * dth from heading a; a few mrad between poses 5 ms apart, so a series
-    // (error below d^8 / 40320, under 1e-16 for d < 0.05 rad) instead of a sin and a cos per beam.
+    // (error below d^8 / 40320, under 1e-15 for d < 0.05 rad) instead of a sin and a cos per beam.
     const double d = u * dth;
     double cd, sd;
     if (std::abs(d) < 0.05) {
