@@ -41,8 +41,9 @@ int main(int argc, char** argv) {
     return traverse::kConfigErrorExitCode;
   }
   std::signal(SIGUSR1, on_usr1);
-  // Live, a worker thread does the mapping so that the socket is read while a loop closure's
-  // moves are applied; a replay works inline (it would otherwise queue the whole log).
+  // Live, a worker thread does the mapping so that status and export requests are answered while
+  // a loop closure's moves are applied; a replay works inline (it would otherwise queue the whole
+  // log).
   traverse::mapper::MapperNode node(
       proc.bus(), config, rig.laser_profile.transform(),
       [&proc](const std::string& name, double v) { proc.counter(name) = v; }, !proc.replaying());

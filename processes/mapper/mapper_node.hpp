@@ -8,9 +8,10 @@
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
-// whole route), and a process that stops reading its socket for that long loses every datagram
-// that overflows the receive buffer (on office-s2, when a move took 40 s, a third of the profiles
-// and segment messages).
+// whole route). The bus already queues what arrives meanwhile (bus.hpp), so nothing is lost
+// either way; the worker keeps the process's own thread free for its status every second and
+// for export requests, and applies the moves once per batch of everything queued, so a loop
+// closure sent in several messages re-places a profile once per batch, not once per message.
 // The queue keeps the order of arrival, so the result is the same as handling each message at
 // once; offline (--replay) the node works inline instead, which keeps memory bounded. The status
 // counters map_lag_s / map_lag_max_s say how long the map trails what has arrived [s]: the time
