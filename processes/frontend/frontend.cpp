@@ -202,6 +202,7 @@ FrontendResult Frontend::process(const Scan& scan) {
     result.status = ScanStatus::kPredicted;
     if (initialised_) {
       result.T_map_base = predict(scan.utime_last, use_imu);
+      result.T_map_base_predicted = result.T_map_base;
       const Eigen::Vector3d prior(std::pow(config_.matcher.prior_sigma_xy_m, 2),
                                   std::pow(config_.matcher.prior_sigma_xy_m, 2),
                                   std::pow(config_.matcher.prior_sigma_theta_rad, 2));
@@ -223,6 +224,7 @@ FrontendResult Frontend::process(const Scan& scan) {
     result.matched_points = static_cast<int>(points.size());
   } else {
     const Pose2 T_pred = predict(scan.utime_last, use_imu);
+    result.T_map_base_predicted = T_pred;
     deskew(points, utimes, scan.utime_last, use_imu);
     // Should the prediction fail, the recovery also searches around the last pose (no motion).
     std::vector<Pose2> other_centres;

@@ -39,6 +39,7 @@ struct FrontendResult {
   int64_t utime = 0;  // [us] time the pose is valid at: the scan's last point
   Pose2 T_map_base;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // (x [m], y [m], theta [rad])
+  Pose2 T_map_base_predicted;  // the motion prediction the match started from
   bool map_updated = false;
   bool imu_used = false;
   int valid_points = 0;

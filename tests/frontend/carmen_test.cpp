@@ -9,8 +9,10 @@
 #include <filesystem>
 
 #include "carmen_log.hpp"
+#include "carmen_node.hpp"
 #include "config.hpp"
 #include "frontend.hpp"
+#include "scan_message.hpp"
 
 namespace traverse::frontend {
 namespace {
@@ -53,15 +55,11 @@ Metrics run_log(const std::string& path) {
   Frontend frontend(config);
   std::vector<Pose2> ref, est;
   Metrics m;
+  // The scans as traverse-carmen publishes them (configs/carmen.yaml defaults) and
+  // traverse-frontend reads them: the same figures as scripts/eval-carmen.sh --stages frontend.
+  const carmen::CarmenConfig carmen_config;
   while (auto s = reader.next()) {
-    Scan scan;
-    scan.utime_first = scan.utime_last = s->utime;
-    scan.angle_first = s->beams.angle_first;
-    scan.angle_step = s->beams.angle_step;
-    // As the driver publishes them (configs/carmen.yaml defaults): no-return markers are 50 m+.
-    scan.range_min = 0.05;
-    scan.range_max = 49.9;
-    scan.ranges = s->ranges;
+    const Scan scan = to_planar_scan(carmen::to_scan_message(*s, carmen_config));
     const FrontendResult r = frontend.process(scan);
     if (r.status == ScanStatus::kDropped) continue;
     if (r.status == ScanStatus::kPredicted) ++m.predicted;
