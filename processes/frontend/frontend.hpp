@@ -2,18 +2,21 @@
 //   1. keep the valid readings of the scan (finite, inside the scanner's and the config's range);
 //   2. predict the pose at the scan's last point by constant velocity (heading change from the
 //      IMU when one is publishing); for sparse scans (more than matcher.wide_search_gap_us after
-//      the last pose: a log subsampled by travel) by the average step per scan;
+//      the last pose, or in a stream whose recent scans were: a log subsampled by travel) by
+//      the average step per scan;
 //   3. undo the motion during the sweep: every point is moved into the base frame at the scan's
 //      last point with the heading change at its own time (IMU yaw rate, or the constant
 //      angular velocity without IMU) and, optionally, the constant-velocity translation;
 //   4. match the points against the map pyramid, coarse to fine, from the prediction (sparse
 //      scans: from the best pose of a wide correlative search around it);
 //   5. update the map when the pose moved or turned past a threshold since the last update.
-// A scan with too few valid points gets the predicted pose (flagged); a scan whose time does not
-// advance, or whose last point is before its first, is dropped. Both are counted.
+// A scan with too few valid points, or whose match on a scanner's stream lands far from the
+// prediction with a poor fit, gets the predicted pose (flagged); a scan whose time does not
+// advance, or whose last point is before its first, is dropped. Each case is counted.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -30,7 +33,7 @@ using Scan = PlanarScan;
 
 enum class ScanStatus {
   kMatched,    // pose measured by matching (the first scan: pose defines the map frame)
-  kPredicted,  // too few valid points: pose predicted from motion
+  kPredicted,  // pose predicted from motion: too few valid points, or an unverified match
   kDropped,    // time does not advance or is inconsistent: no pose
 };
 
@@ -53,6 +56,7 @@ struct FrontendCounters {
   int64_t scans_received = 0;
   int64_t scans_matched = 0;
   int64_t scans_predicted = 0;     // too few valid points
+  int64_t scans_unverified = 0;    // match far from the prediction with a poor fit: predicted
   int64_t scans_searched = 0;      // matches that needed the recovery search
   int64_t scans_dropped_time = 0;  // time going backwards or utime_last < utime_first
   int64_t readings_invalid = 0;    // NaN, zero or out-of-range readings ignored
@@ -88,6 +92,10 @@ class Frontend {
   std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& points) const;
   void update_motion(const Pose2& T_map_base, int64_t utime);
   bool map_update_due(const Pose2& T_map_base) const;
+  // Gives `result` the predicted pose and a covariance grown by the prior's from the last one.
+  void take_prediction(FrontendResult& result, const Pose2& T_pred);
+  // Whether a scan at `utime` is matched as a sparse scan (see the config's wide_search_gap_us).
+  bool sparse(int64_t utime) const;
 
   FrontendConfig config_;
   Pose2 T_base_laser_;
@@ -105,6 +113,10 @@ class Frontend {
   Eigen::Vector3d sparse_step_ = Eigen::Vector3d::Zero();
   bool have_sparse_step_ = false;
   Eigen::Matrix3d covariance_last_ = Eigen::Matrix3d::Zero();
+  // The intervals between the last kRecentIntervals poses [us] (a ring), and how many were seen.
+  static constexpr std::size_t kRecentIntervals = 5;
+  std::array<int64_t, kRecentIntervals> recent_intervals_us_{};
+  std::size_t interval_count_ = 0;
 
   // Reused between scans: beam directions of the last scan geometry, and point buffers.
   std::size_t beam_n_ = 0;

@@ -54,6 +54,13 @@ struct MatcherConfig {
   double search_trigger_residual = 0.35;
   double search_linear_window_m = 1.0;     // +- in x and y
   double search_angular_window_rad = 0.8;  // +-
+  // A searched result that lies farther than this from the prediction, in translation or in
+  // heading, is kept only if it brings the residual under search_trigger_residual. A scan that
+  // fits nowhere well (people next to the scanner, a view the map has not seen) otherwise moves
+  // the pose to wherever a part of it fits best: a jump of metres where the prediction, a scanner
+  // period ahead, is off by centimetres. The Gauss-Newton result from the prediction stands.
+  double search_max_unverified_m = 0.5;
+  double search_max_unverified_rad = 0.2;
   // Sparse scans: a scan more than wide_search_gap_us after the previous pose does not come from
   // a scanner's stream but from a log subsampled by travel (the CARMEN sets: 0.5 to 1.8 m and up
   // to 80 degrees between scans, no odometry). Constant velocity predicts such a step poorly, so
@@ -79,6 +86,8 @@ struct MatcherConfig {
     v("search_trigger_residual", search_trigger_residual);
     v("search_linear_window_m", search_linear_window_m);
     v("search_angular_window_rad", search_angular_window_rad);
+    v("search_max_unverified_m", search_max_unverified_m);
+    v("search_max_unverified_rad", search_max_unverified_rad);
     v("wide_search_gap_us", wide_search_gap_us);
     v("wide_search_linear_window_m", wide_search_linear_window_m);
     v("wide_search_angular_window_rad", wide_search_angular_window_rad);
@@ -158,6 +167,8 @@ inline std::optional<std::string> config_problem(const FrontendConfig& c) {
     return "matcher.max_range_m must exceed min_range_m";
   if (!(c.matcher.search_linear_window_m > 0.0 && c.matcher.search_angular_window_rad > 0.0))
     return "matcher.search_linear_window_m and search_angular_window_rad must be positive";
+  if (!(c.matcher.search_max_unverified_m >= 0.0 && c.matcher.search_max_unverified_rad >= 0.0))
+    return "matcher.search_max_unverified_m and search_max_unverified_rad must not be negative";
   if (!(c.matcher.wide_search_linear_window_m > 0.0 &&
         c.matcher.wide_search_angular_window_rad > 0.0 &&
         c.matcher.wide_search_angular_window_rad <= 3.1416))

@@ -57,6 +57,7 @@ void FrontendNode::report_counters() {
   counters_("scans_received", static_cast<double>(c.scans_received));
   counters_("scans_matched", static_cast<double>(c.scans_matched));
   counters_("scans_predicted", static_cast<double>(c.scans_predicted));
+  counters_("scans_unverified", static_cast<double>(c.scans_unverified));
   counters_("scans_searched", static_cast<double>(c.scans_searched));
   counters_("scans_dropped_time", static_cast<double>(c.scans_dropped_time));
   counters_("scans_waiting_for_imu", static_cast<double>(pending_.size()));

@@ -254,6 +254,10 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
     MatchResult candidate =
         refine(maps, points_base, T_start, centre, config, first_level, last_level);
     iterations += candidate.iterations;
+    const Pose2 d = between(T_map_base_predicted, candidate.T_map_base);
+    const bool far = d.translation().norm() > config.search_max_unverified_m ||
+                     std::abs(d.theta()) > config.search_max_unverified_rad;
+    if (far && candidate.residual_rms > config.search_trigger_residual) continue;
     if (candidate.residual_rms < result.residual_rms) {
       result = candidate;
       result.searched = true;

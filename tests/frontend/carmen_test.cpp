@@ -111,15 +111,18 @@ TEST_P(CarmenLog, TracksReference) {
 }
 
 // Bounds a little above what the frontend reaches (measured, configs/frontend.yaml; rpe_1m /
-// rpe_10m / max_jump): freiburg-079 0.051 / 0.103 / 0.74 m, intel 0.104 / 0.118 / 0.67 m, aces
-// 0.092 / 0.260 / 0.81 m, csail 0.056 / 0.144 / 0.41 m. Issue 4 asks for max_jump under 0.5 m
-// on all four: not reached yet on freiburg-079, intel and aces (a few single mis-matched scans);
-// these bounds guard what is reached. Before the wide search for sparse scans, intel, aces and
-// csail lost track (rpe_10m 2.97 / 4.31 / 4.18 m).
+// rpe_10m / max_jump): freiburg-079 0.046 / 0.098 / 0.18 m, intel 0.098 / 0.138 / 0.84 m, aces
+// 0.073 / 0.190 / 0.54 m, csail 0.056 / 0.144 / 0.41 m. Issue 4 asks for max_jump under 0.5 m
+// on all four: not reached yet on intel and aces (an along-corridor step misjudged where the
+// scan cannot tell and the prediction is poor; one scan of intel matched 20 degrees off in a
+// view the map has not seen); these bounds guard what is reached. Before the gate on far
+// searched poses (search_max_unverified_m), freiburg-079 jumped 0.75 m at a scan crowded by
+// something near the scanner. Before the wide search for sparse scans, intel, aces and csail
+// lost track (rpe_10m 2.97 / 4.31 / 4.18 m).
 INSTANTIATE_TEST_SUITE_P(Logs, CarmenLog,
-                         ::testing::Values(LogCase{"freiburg-079", 4700, 0.1, 0.25, 1.0},
+                         ::testing::Values(LogCase{"freiburg-079", 4700, 0.06, 0.15, 0.5},
                                            LogCase{"intel", 900, 0.15, 0.2, 1.0},
-                                           LogCase{"aces", 430, 0.15, 0.4, 1.0},
+                                           LogCase{"aces", 430, 0.1, 0.3, 0.75},
                                            LogCase{"csail", 400, 0.1, 0.25, 0.5}),
                          [](const auto& info) {
                            std::string n = info.param.name;
