@@ -253,14 +253,15 @@ FrontendResult Frontend::process(const Scan& scan) {
     }
     const bool sparse_scan = sparse(scan.utime_last);
     const MatchResult m =
-        sparse_scan ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher)
-                    : match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0,
-                                 other_centres);
+        sparse_scan
+            ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher)
+            : match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
     // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes
     // from a scan that fits nowhere (people round the scanner, a view the map has not seen):
     // the pose is the prediction, flagged, and the scan stays out of the map. Sparse scans are
     // predicted too poorly for this (their steps of a metre are what the wide search is for).
+    if (m.searched) ++counters_.scans_searched;
     const Pose2 d = between(T_pred, m.T_map_base);
     if (!sparse_scan && m.residual_rms > config_.matcher.search_trigger_residual &&
         (d.translation().norm() > config_.matcher.search_max_unverified_m ||
@@ -278,7 +279,6 @@ FrontendResult Frontend::process(const Scan& scan) {
     result.iterations = m.iterations;
     result.residual_rms = m.residual_rms;
     result.searched = m.searched;
-    if (m.searched) ++counters_.scans_searched;
   }
   ++counters_.scans_matched;
   covariance_last_ = result.covariance;

@@ -58,17 +58,19 @@ struct MatcherConfig {
   // heading, is kept only if it brings the residual under search_trigger_residual. A scan that
   // fits nowhere well (people next to the scanner, a view the map has not seen) otherwise moves
   // the pose to wherever a part of it fits best: a jump of metres where the prediction, a scanner
-  // period ahead, is off by centimetres. The Gauss-Newton result from the prediction stands.
+  // period ahead, is off by centimetres. The Gauss-Newton result from the prediction stands; if
+  // that too ends this far off with a poor fit, the scan gets the prediction (flagged).
   double search_max_unverified_m = 0.5;
   double search_max_unverified_rad = 0.2;
-  // Sparse scans: a scan more than wide_search_gap_us after the previous pose does not come from
-  // a scanner's stream but from a log subsampled by travel (the CARMEN sets: 0.5 to 1.8 m and up
-  // to 80 degrees between scans, no odometry). Constant velocity predicts such a step poorly, so
-  // it is always matched by a wide correlative search (branch and bound) around the prediction
-  // (the average step of the last scans) within the windows below, then Gauss-Newton from the
-  // best pose.
+  // Sparse scans: a scan more than wide_search_gap_us after the previous pose (or one in a
+  // stream whose last five intervals have a median above it: such logs repeat timestamps) does
+  // not come from a scanner's stream but from a log subsampled by travel (the CARMEN sets: 0.5
+  // to 1.8 m and up to 80 degrees between scans, no odometry). Constant velocity predicts such a
+  // step poorly, so it is always matched by a wide correlative search (branch and bound) around
+  // the prediction (the average step of the last scans) within the windows below, then
+  // Gauss-Newton from the best pose.
   int64_t wide_search_gap_us = 500000;
-  double wide_search_linear_window_m = 2.0;     // +- in x and y
+  double wide_search_linear_window_m = 2.0;  // +- in x and y
   // +-; 80 degree turns between scans and a prediction 60 degrees off happen in the CARMEN sets.
   double wide_search_angular_window_rad = 2.5;
 
