@@ -59,11 +59,25 @@ stale() {
 # run_graph IN OUTDIR STAGES SPEED: runs the stages on IN; OUTDIR/run.lcmlog records every
 # channel. With OFFLINE=1 the stages run one after another on the log instead of live on a bus
 # (traverse-launch --offline: no transport loss, as fast as they compute, same result each time). Its output goes to OUTDIR/graph.out; its JSON line (if any) is kept in GRAPH_JSON.
+# With DESKEW_OFF=1 the frontend runs with configs/frontend.yaml but deskew.enabled false (the
+# config and the pipeline using it are written to OUTDIR).
 run_graph() {
   local in="$1" out="$2" stages="$3" speed="$4"
   [[ -x $ROOT/scripts/run-graph.sh ]] || die "scripts/run-graph.sh not found"
-  local rc=0
-  TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$ROOT/configs/deploy/pipeline.yaml" \
+  local rc=0 deploy="$ROOT/configs/deploy/pipeline.yaml"
+  if [[ -n ${DESKEW_OFF:-} ]]; then
+    awk '/^[^ #]/ { in_deskew = ($1 == "deskew:") }
+         in_deskew && $1 == "enabled:" { sub(/true/, "false") } { print }' \
+      "$ROOT/configs/frontend.yaml" >"$out/frontend-deskew-off.yaml"
+    grep -q '^  enabled: false' "$out/frontend-deskew-off.yaml" ||
+      die "configs/frontend.yaml has no 'deskew: enabled: true' to switch off"
+    sed "s#^\(    config: \)configs/frontend.yaml#\1$out/frontend-deskew-off.yaml#" "$deploy" \
+      >"$out/pipeline-deskew-off.yaml"
+    grep -q "frontend-deskew-off.yaml" "$out/pipeline-deskew-off.yaml" ||
+      die "configs/deploy/pipeline.yaml does not run the frontend with configs/frontend.yaml"
+    deploy="$out/pipeline-deskew-off.yaml"
+  fi
+  TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$deploy" \
     --log "$in" --out "$out" --speed "$speed" --stages "$stages" ${OFFLINE:+--offline} \
     >"$out/graph.out" 2>&1 || rc=$?
   GRAPH_JSON="$(last_json_line "$out/graph.out")"

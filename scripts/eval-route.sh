@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--speed S] [--offline] [--duration S]
+#                       [--deskew-off]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim (cached as out/cache/ROUTE-seedN.lcmlog, regenerated when the sim program, the
@@ -16,8 +17,11 @@
 #   --offline      run the stages one after another on the log (--replay/--record) instead of
 #                  live on a bus: no transport loss, as fast as they compute, the same figures
 #                  every time; --speed is then ignored
+#   --deskew-off   the frontend with configs/frontend.yaml but deskew.enabled false, to measure
+#                  what de-skew buys (outputs under ROUTE-seedN-STAGES-deskew-off)
 set -euo pipefail
 OFFLINE=""
+DESKEW_OFF=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -34,6 +38,7 @@ while (($#)); do
     --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
     --offline) OFFLINE=1; shift ;;
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
+    --deskew-off) DESKEW_OFF=1; shift ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $route ]] || usage; route="$1"; shift ;;
@@ -71,11 +76,11 @@ if stale "$cache" "$BIN/traverse-sim" "$route_file" "$world_file"; then
 fi
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
-out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")"
+out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")${DESKEW_OFF:+-deskew-off}"
 run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_GROUND_TRUTH
 if runs_mapper "$stages"; then
   need_programs traverse-cloud-eval
   cloud_evaluate "$world_file" "$out"
 fi
 echo "eval-route: $route seed $seed stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"deskew_off\": $([[ -n $DESKEW_OFF ]] && echo true || echo false), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
