@@ -98,13 +98,13 @@ void Frontend::valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& poin
   }
 }
 
-Pose2 Frontend::predict(int64_t utime, bool use_imu) const {
+Pose2 Frontend::predict(int64_t utime, bool use_imu, bool sparse_scan) const {
   // A scanner's stream: constant velocity over the elapsed time, but over at most twice the last
   // interval (after a pause it would predict an arbitrarily long step). Scans further apart than
   // any scanner's period are a log subsampled by travel (the CARMEN sets): their times say little
   // about the motion; the average of the last steps predicts better (see update_motion()).
   const int64_t elapsed = utime - last_utime_;
-  if (sparse(utime) && have_sparse_step_ && !use_imu) {
+  if (sparse_scan && have_sparse_step_ && !use_imu) {
     return T_map_base_last_ * Pose2::exp(sparse_step_);
   }
   const int64_t horizon = std::min(elapsed, 2 * last_interval_us_);
@@ -151,7 +151,7 @@ std::vector<Eigen::Vector2d> Frontend::subsample(const std::vector<Eigen::Vector
   return kept;
 }
 
-void Frontend::update_motion(const Pose2& T_map_base, int64_t utime) {
+void Frontend::update_motion(const Pose2& T_map_base, int64_t utime, bool sparse_scan) {
   if (initialised_) {
     const double dt = 1e-6 * static_cast<double>(utime - last_utime_);
     const Eigen::Vector3d v = between(T_map_base_last_, T_map_base).log() / dt;
@@ -162,7 +162,7 @@ void Frontend::update_motion(const Pose2& T_map_base, int64_t utime) {
     // moves about the same distance per scan, so the average keeps predicting forward motion
     // where one step was underestimated (a corridor that does not show motion along its axis):
     // repeating the last step would repeat the stall.
-    if (sparse(utime)) {
+    if (sparse_scan) {
       const Eigen::Vector3d step = between(T_map_base_last_, T_map_base).log();
       constexpr double a = kSparseStepSmoothing;
       sparse_step_ =
@@ -184,14 +184,13 @@ bool Frontend::sparse(int64_t utime) const {
   // 0.5 s apart, some 0 s) that say nothing about the motion in between.
   const int64_t gap = config_.matcher.wide_search_gap_us;
   if (utime - last_utime_ > gap) return true;
-  const std::size_t n = std::min(interval_count_, recent_intervals_us_.size());
-  if (n < recent_intervals_us_.size()) return false;
+  if (interval_count_ < kRecentIntervals) return false;
   std::array<int64_t, kRecentIntervals> sorted = recent_intervals_us_;
-  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-  return sorted[n / 2] > gap;
+  std::nth_element(sorted.begin(), sorted.begin() + kRecentIntervals / 2, sorted.end());
+  return sorted[kRecentIntervals / 2] > gap;
 }
 
-void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred) {
+void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred, bool sparse_scan) {
   result.T_map_base = T_pred;
   result.T_map_base_predicted = T_pred;
   const Eigen::Vector3d prior(std::pow(config_.matcher.prior_sigma_xy_m, 2),
@@ -200,7 +199,7 @@ void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred) {
   result.covariance = covariance_last_ + Eigen::Matrix3d(prior.asDiagonal());
   covariance_last_ = result.covariance;
   const Eigen::Vector3d velocity = velocity_;
-  update_motion(result.T_map_base, result.utime);
+  update_motion(result.T_map_base, result.utime, sparse_scan);
   velocity_ = velocity;  // a prediction carries no new information about the motion
 }
 
@@ -226,10 +225,13 @@ FrontendResult Frontend::process(const Scan& scan) {
   result.valid_points = static_cast<int>(points.size());
   const bool use_imu = imu_active(scan);
   result.imu_used = use_imu;
+  const bool sparse_scan = initialised_ && sparse(scan.utime_last);
 
   if (static_cast<int>(points.size()) < config_.matcher.min_valid_points) {
     ++counters_.scans_predicted;
-    if (initialised_) take_prediction(result, predict(scan.utime_last, use_imu));
+    if (initialised_) {
+      take_prediction(result, predict(scan.utime_last, use_imu, sparse_scan), sparse_scan);
+    }
     result.status = ScanStatus::kPredicted;
     return result;
   }
@@ -242,7 +244,7 @@ FrontendResult Frontend::process(const Scan& scan) {
     result.covariance = Eigen::Matrix3d::Identity() * 1e-12;
     result.matched_points = static_cast<int>(points.size());
   } else {
-    const Pose2 T_pred = predict(scan.utime_last, use_imu);
+    const Pose2 T_pred = predict(scan.utime_last, use_imu, sparse_scan);
     result.T_map_base_predicted = T_pred;
     deskew(points, utimes, scan.utime_last, use_imu);
     // Should the prediction fail, the recovery also searches around the last pose (no motion).
@@ -251,7 +253,6 @@ FrontendResult Frontend::process(const Scan& scan) {
         std::abs(between(T_pred, T_map_base_last_).theta()) > 0.01) {
       other_centres.push_back(T_map_base_last_);
     }
-    const bool sparse_scan = sparse(scan.utime_last);
     const MatchResult m =
         sparse_scan
             ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher)
@@ -262,12 +263,9 @@ FrontendResult Frontend::process(const Scan& scan) {
     // the pose is the prediction, flagged, and the scan stays out of the map. Sparse scans are
     // predicted too poorly for this (their steps of a metre are what the wide search is for).
     if (m.searched) ++counters_.scans_searched;
-    const Pose2 d = between(T_pred, m.T_map_base);
-    if (!sparse_scan && m.residual_rms > config_.matcher.search_trigger_residual &&
-        (d.translation().norm() > config_.matcher.search_max_unverified_m ||
-         std::abs(d.theta()) > config_.matcher.search_max_unverified_rad)) {
+    if (!sparse_scan && unverified(m, T_pred, config_.matcher)) {
       ++counters_.scans_unverified;
-      take_prediction(result, T_pred);
+      take_prediction(result, T_pred, sparse_scan);
       result.residual_rms = m.residual_rms;
       result.searched = m.searched;
       result.status = ScanStatus::kPredicted;
@@ -291,7 +289,7 @@ FrontendResult Frontend::process(const Scan& scan) {
     ++counters_.map_updates;
     result.map_updated = true;
   }
-  update_motion(result.T_map_base, scan.utime_last);
+  update_motion(result.T_map_base, scan.utime_last, sparse_scan);
   initialised_ = true;
   return result;
 }

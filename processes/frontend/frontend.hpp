@@ -86,15 +86,16 @@ class Frontend {
   void valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& points_base,
                     std::vector<int64_t>& utimes);
   bool imu_active(const Scan& scan) const;
-  Pose2 predict(int64_t utime, bool use_imu) const;
+  Pose2 predict(int64_t utime, bool use_imu, bool sparse_scan) const;
   void deskew(std::vector<Eigen::Vector2d>& points_base, const std::vector<int64_t>& utimes,
               int64_t utime_ref, bool use_imu) const;
   std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& points) const;
-  void update_motion(const Pose2& T_map_base, int64_t utime);
+  void update_motion(const Pose2& T_map_base, int64_t utime, bool sparse_scan);
   bool map_update_due(const Pose2& T_map_base) const;
   // Gives `result` the predicted pose and a covariance grown by the prior's from the last one.
-  void take_prediction(FrontendResult& result, const Pose2& T_pred);
-  // Whether a scan at `utime` is matched as a sparse scan (see the config's wide_search_gap_us).
+  void take_prediction(FrontendResult& result, const Pose2& T_pred, bool sparse_scan);
+  // Whether a scan at `utime` is matched as a sparse scan (see the config's wide_search_gap_us);
+  // decided once per scan, before the motion state changes.
   bool sparse(int64_t utime) const;
 
   FrontendConfig config_;

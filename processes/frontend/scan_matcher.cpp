@@ -236,6 +236,14 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
 
 }  // namespace
 
+bool unverified(const MatchResult& m, const Pose2& T_map_base_predicted,
+                const MatcherConfig& config) {
+  const Pose2 d = between(T_map_base_predicted, m.T_map_base);
+  return m.residual_rms > config.search_trigger_residual &&
+         (d.translation().norm() > config.search_max_unverified_m ||
+          std::abs(d.theta()) > config.search_max_unverified_rad);
+}
+
 MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
                        const Pose2& T_map_base_predicted, const MatcherConfig& config,
                        int first_level, int last_level, const std::vector<Pose2>& other_centres) {
@@ -254,10 +262,7 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
     MatchResult candidate =
         refine(maps, points_base, T_start, centre, config, first_level, last_level);
     iterations += candidate.iterations;
-    const Pose2 d = between(T_map_base_predicted, candidate.T_map_base);
-    const bool far = d.translation().norm() > config.search_max_unverified_m ||
-                     std::abs(d.theta()) > config.search_max_unverified_rad;
-    if (far && candidate.residual_rms > config.search_trigger_residual) continue;
+    if (unverified(candidate, T_map_base_predicted, config)) continue;
     if (candidate.residual_rms < result.residual_rms) {
       result = candidate;
       result.searched = true;

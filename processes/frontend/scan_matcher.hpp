@@ -79,10 +79,16 @@ Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>&
 MatchResult match_scan_wide(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
                             const std::vector<Pose2>& priors, const MatcherConfig& config);
 
+// A match with a poor fit (residual above config.search_trigger_residual) that ends farther from
+// the prediction than config.search_max_unverified_m or _rad: nothing confirms such a jump.
+bool unverified(const MatchResult& m, const Pose2& T_map_base_predicted,
+                const MatcherConfig& config);
+
 // Matches points (base frame) against the pyramid from T_map_base_predicted. `first_level` and
 // `last_level` select the pyramid levels used, coarse to fine (defaults: all). When the result's
 // residual exceeds config.search_trigger_residual, searches around the prediction and around
-// each of `other_centres` (e.g. the last pose: no motion), refines each, keeps the best.
+// each of `other_centres` (e.g. the last pose: no motion), refines each, and keeps the best of
+// the candidates that are not unverified().
 MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
                        const Pose2& T_map_base_predicted, const MatcherConfig& config,
                        int first_level = -1, int last_level = 0,
