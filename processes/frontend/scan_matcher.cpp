@@ -275,11 +275,14 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
 MatchResult match_scan_wide(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
                             const std::vector<Pose2>& priors, const MatcherConfig& config) {
   const int search_level = std::min(1, maps.levels() - 1);
-  const WideSearchResult s = wide_search(maps.level(search_level), points_base, priors.front(),
-                                         config.wide_search_linear_window_m,
-                                         config.wide_search_angular_window_rad, priors);
+  const WideSearchResult s = wide_search(
+      maps.level(search_level), points_base, priors.front(), config.wide_search_linear_window_m,
+      config.wide_search_angular_window_rad, priors, config.wide_search_temperature);
   MatchResult result =
       refine(maps, points_base, s.T_map_base, s.T_map_base, config, maps.levels() - 1, 0);
+  // The Gauss-Newton covariance is the curvature where it ended; the search's spread adds what
+  // the scan leaves open beyond it (an axis it cannot tell, a second pose that fits as well).
+  result.covariance += s.covariance;
   result.searched = true;
   return result;
 }

@@ -8,12 +8,15 @@ namespace traverse::frontend {
 namespace {
 // Weight of the motion prior in the wide search, per point (see wide_search()).
 constexpr double kMotionWeight = 0.05;
+// Poses scoring more than this many temperatures below the best weigh under exp(-8) = 3e-4 in the
+// score surface's spread, and are left out of it.
+constexpr double kSurfaceMargin = 8.0;
 }  // namespace
 
 WideSearchResult wide_search(const OccupancyGrid& grid,
                              const std::vector<Eigen::Vector2d>& points_base, const Pose2& T_center,
                              double linear_window_m, double angular_window_rad,
-                             const std::vector<Pose2>& priors) {
+                             const std::vector<Pose2>& priors, double temperature) {
   // Block side of the coarse level of the branch and bound [cells]: a coarse candidate stands for
   // kBlock x kBlock translations, bounded by the maximum of the table over that block.
   constexpr int kBlock = 4;
@@ -147,15 +150,28 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& l, const Candidate& r) { return l.bound > r.bound; });
-  // Level 0: blocks in order of their bound, until no block can beat the best pose found.
+  // Level 0: blocks in order of their bound, until no block can hold a pose within `margin` of
+  // the best pose found (those poses make the score surface's spread, below).
+  const float margin = static_cast<float>(kSurfaceMargin * temperature);
   float best = -std::numeric_limits<float>::infinity();
   int best_a = n_angles, best_dx = 0, best_dy = 0;
+  struct Scored {
+    float s;
+    int a, dx, dy;
+  };
+  std::vector<Scored> near_best;
+  std::size_t kept = 0;
   for (const Candidate& c : candidates) {
-    if (c.bound <= best) break;
+    if (c.bound <= best - margin) break;
     for (int dy = c.dy; dy < c.dy + kBlock && dy <= n_shift; ++dy) {
       for (int dx = c.dx; dx < c.dx + kBlock && dx <= n_shift; ++dx) {
         const float s = score_of(table, c.a, dx, dy) - penalty(c.a, dx, dy, 1);
         ++result.evaluated;
+        if (temperature > 0.0 && s > best - margin) near_best.push_back({s, c.a, dx, dy});
+        if (near_best.size() > 2 * kept + 4096) {  // drop those the best has left behind
+          std::erase_if(near_best, [&](const Scored& p) { return p.s <= best - margin; });
+          kept = near_best.size();
+        }
         if (s > best) {
           best = s;
           best_a = c.a;
@@ -168,6 +184,25 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
   result.T_map_base = Pose2(T_center.x() + best_dx * res, T_center.y() + best_dy * res,
                             T_center.theta() + (best_a - n_angles) * angle_step);
   result.score = score_of(table, best_a, best_dx, best_dy) / n_points;
+
+  // Spread of the pose over the score surface: every pose within the margin of the best,
+  // weighted by exp((score - best) / temperature), offsets from the best in m and rad. Taken
+  // about the best pose (the one reported), not about the weighted mean: a second mode as good
+  // is a second place the pose may be.
+  if (temperature > 0.0) {
+    double w_sum = 0.0;
+    Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+    for (const Scored& p : near_best) {
+      if (p.s <= best - margin) continue;
+      const double w = std::exp((p.s - best) / temperature);
+      const Eigen::Vector3d d((p.dx - best_dx) * res, (p.dy - best_dy) * res,
+                              wrap_angle((p.a - best_a) * angle_step));
+      w_sum += w;
+      second += w * d * d.transpose();
+      ++result.poses_in_spread;
+    }
+    result.covariance = second / w_sum;
+  }
   return result;
 }
 

@@ -59,6 +59,63 @@ TEST(ScanMatcher, WideSearchFindsSparseScanFarFromPrediction) {
   EXPECT_LT(std::abs(wrap_angle(r.T_map_base.theta() - truth.theta())), 0.003);
 }
 
+// The wide search's score surface shows what a sparse scan leaves open: in the room its spread is
+// below a cell (only the best pose counts), along a featureless corridor it reaches decimetres
+// (every step along the axis scores alike and only the motion prior decides), across it it stays
+// as small as in the room. match_scan_wide adds it to the Gauss-Newton covariance.
+TEST(ScanMatcher, WideSearchSpreadGrowsAlongCorridorAxis) {
+  const auto front_half = [](const std::vector<Eigen::Vector2d>& all) {
+    std::vector<Eigen::Vector2d> front;
+    for (const auto& p : all) {
+      if (p.x() > 0.0) front.push_back(p);
+    }
+    return front;
+  };
+  MatcherConfig config;
+  const auto room = synthetic::room();
+  const MapPyramid room_map = build_map(room, {kMapPose, Pose2(-1.5, 1.0, 0.0)});
+  const Pose2 truth(0.5, 0.4, 0.3);
+  const auto room_points = front_half(static_scan(room, truth, 360, 0.005));
+  const Pose2 start(truth.x() - 0.6, truth.y() + 0.4, truth.theta() - 0.5);
+  const WideSearchResult in_room = wide_search(room_map.level(1), room_points, start, 2.0, 1.5,
+                                               {start}, config.wide_search_temperature);
+
+  const auto corridor = synthetic::corridor(200.0, 2.4);
+  std::vector<Pose2> walk;
+  for (double x = -20.0; x <= 20.0; x += 0.37) walk.emplace_back(x, 0.0, 0.0);
+  const MapPyramid corridor_map = build_map(corridor, walk);
+  const Pose2 along(0.4, 0.1, 0.0);
+  const auto corridor_points = front_half(static_scan(corridor, along, 360, 0.005, 1, 15.0));
+  const WideSearchResult in_corridor =
+      wide_search(corridor_map.level(1), corridor_points, Pose2(), 2.0, 1.5, {Pose2()},
+                  config.wide_search_temperature);
+
+  const Eigen::Matrix3d& Cr = in_room.covariance;
+  const Eigen::Matrix3d& Cc = in_corridor.covariance;
+  std::printf(
+      "spread x, y [m], theta [rad]: room %.4f %.4f %.4f (%lld poses), corridor %.4f %.4f "
+      "%.4f (%lld poses)\n",
+      std::sqrt(Cr(0, 0)), std::sqrt(Cr(1, 1)), std::sqrt(Cr(2, 2)),
+      static_cast<long long>(in_room.poses_in_spread), std::sqrt(Cc(0, 0)), std::sqrt(Cc(1, 1)),
+      std::sqrt(Cc(2, 2)), static_cast<long long>(in_corridor.poses_in_spread));
+  EXPECT_LT(std::sqrt(Cr(0, 0)), 0.02);
+  EXPECT_LT(std::sqrt(Cr(1, 1)), 0.02);
+  EXPECT_LT(std::sqrt(Cr(2, 2)), 0.02);  // a search step in angle moves a point 5 m out one cell
+  EXPECT_GT(std::sqrt(Cc(0, 0)), 0.2);
+  EXPECT_LT(std::sqrt(Cc(1, 1)), 0.03);
+  // Without a temperature there is no spread.
+  EXPECT_EQ(wide_search(corridor_map.level(1), corridor_points, Pose2(), 2.0, 1.5, {Pose2()}, 0.0)
+                .covariance,
+            Eigen::Matrix3d::Zero());
+  // The match reports it on top of the Gauss-Newton covariance; across the axis it stays small.
+  const MatchResult m = match_scan_wide(corridor_map, corridor_points, {Pose2()}, config);
+  config.wide_search_temperature = 0.0;
+  const MatchResult gauss_newton_only =
+      match_scan_wide(corridor_map, corridor_points, {Pose2()}, config);
+  EXPECT_NEAR(m.covariance(0, 0), gauss_newton_only.covariance(0, 0) + Cc(0, 0), 1e-9);
+  EXPECT_LT(std::sqrt(m.covariance(1, 1)), 0.03);
+}
+
 // The whole pyramid, coarse to fine, converges from further away than any single fine level.
 TEST(ScanMatcher, PyramidConvergesFromLargeOffset) {
   const auto world = synthetic::room();
