@@ -33,6 +33,7 @@ Evaluation evaluate(Trajectory estimate, Trajectory reference, const EvaluatorCo
   // 1. Match: the reference interpolated at every estimate time.
   const ReferenceInterpolator interpolator(reference, config.match);
   std::vector<Pose2> est, ref;
+  std::vector<Eigen::Matrix3d> cov;
   std::vector<double> travel_m;
   std::vector<int64_t> utimes;
   for (const StampedPose& e : estimate) {
@@ -42,6 +43,7 @@ Evaluation evaluate(Trajectory estimate, Trajectory reference, const EvaluatorCo
       continue;
     }
     est.push_back(e.pose);
+    cov.push_back(e.covariance);
     ref.push_back(r->pose);
     travel_m.push_back(r->travel_m);
     utimes.push_back(e.utime);
@@ -51,6 +53,9 @@ Evaluation evaluate(Trajectory estimate, Trajectory reference, const EvaluatorCo
   // 2. Align the estimate's frame to the reference frame.
   ev.alignment = compute_alignment(*parse_align(config.align), est, ref);
   for (Pose2& p : est) p = ev.alignment.T_ref_est * p;
+  Eigen::Matrix3d A = Eigen::Matrix3d::Identity();  // (x, y, theta) into the reference frame
+  A.topLeftCorner<2, 2>() = ev.alignment.T_ref_est.rotation();
+  for (Eigen::Matrix3d& c : cov) c = A * c * A.transpose();
 
   // 3. Absolute errors per matched pose.
   std::vector<double> position_m, heading_rad;
@@ -74,6 +79,7 @@ Evaluation evaluate(Trajectory estimate, Trajectory reference, const EvaluatorCo
   ev.rpe_1m = relative_pose_error(est, ref, travel_m, 1.0);
   ev.rpe_10m = relative_pose_error(est, ref, travel_m, 10.0);
   ev.max_jump = max_jump(est, ref);
+  ev.step_consistency = step_consistency(est, cov, ref);
   if (!utimes.empty()) {
     ev.duration_s = 1e-6 * static_cast<double>(utimes.back() - utimes.front());
     ev.length_m = travel_m.back() - travel_m.front();

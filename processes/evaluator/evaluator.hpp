@@ -64,9 +64,10 @@ struct Evaluation {
   ErrorStats heading_rad;  // [rad] of |heading error|
   RelativeError rpe_1m;
   RelativeError rpe_10m;
-  Jump max_jump;            // index into samples
-  double duration_s = 0.0;  // [s] from the first to the last matched estimate
-  double length_m = 0.0;    // [m] reference path length over that time
+  Jump max_jump;                     // index into samples
+  StepConsistency step_consistency;  // of the estimate's reported covariances (metrics.hpp)
+  double duration_s = 0.0;           // [s] from the first to the last matched estimate
+  double length_m = 0.0;             // [m] reference path length over that time
 };
 
 // Evaluates `estimate` against `reference` (any order; repeated times keep their first pose).

@@ -1,5 +1,7 @@
 #include "metrics.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -58,6 +60,38 @@ Jump max_jump(const std::vector<Pose2>& est, const std::vector<Pose2>& ref) {
     if (e > jump.step_error_m) jump = {e, k};
   }
   return jump;
+}
+
+StepConsistency step_consistency(const std::vector<Pose2>& est,
+                                 const std::vector<Eigen::Matrix3d>& cov,
+                                 const std::vector<Pose2>& ref) {
+  // The chi-square quantile with 2 degrees of freedom at 99 %.
+  constexpr double kChi2_2dof_99 = 9.21;
+  StepConsistency r;
+  std::vector<double> nees;
+  for (std::size_t k = 1; k < est.size(); ++k) {
+    if (cov[k - 1].isZero() || cov[k].isZero()) continue;
+    const Pose2& a = est[k - 1];
+    const Eigen::Vector2d step = between(a, est[k]).translation();
+    const Eigen::Vector2d e = between(ref[k - 1], ref[k]).translation() - step;
+    const Eigen::Matrix2d R = a.rotation();
+    const Eigen::Vector2d swing(step.y(), -step.x());  // d(step) / d(theta_a)
+    const Eigen::Matrix2d S =
+        R.transpose() * (cov[k - 1].topLeftCorner<2, 2>() + cov[k].topLeftCorner<2, 2>()) * R +
+        cov[k - 1](2, 2) * swing * swing.transpose();
+    const Eigen::LLT<Eigen::Matrix2d> llt(S);
+    if (llt.info() != Eigen::Success || !(S.determinant() > 0.0)) continue;
+    nees.push_back(e.dot(llt.solve(e)));
+  }
+  r.steps = nees.size();
+  if (nees.empty()) return r;
+  r.outside_99_fraction =
+      static_cast<double>(
+          std::count_if(nees.begin(), nees.end(), [&](double d) { return d > kChi2_2dof_99; })) /
+      static_cast<double>(nees.size());
+  std::nth_element(nees.begin(), nees.begin() + nees.size() / 2, nees.end());
+  r.nees_median = nees[nees.size() / 2];
+  return r;
 }
 
 }  // namespace traverse::evaluator

@@ -11,8 +11,14 @@
 // - Largest jump: max over consecutive matched estimates of |est step - true step|, each step the
 //   motion from the previous pose expressed in that pose's frame (a one-step relative error), so
 //   a loop closure that moves the estimate by 0.3 m shows as 0.3 m whatever the heading error.
+// - Step consistency: each step's translation error (as for the largest jump) against the step
+//   covariance made of both poses' reported covariances, taken as independent (right for a
+//   scan-to-map frontend's per-scan covariance), with the start pose's heading variance swinging
+//   the step: NEES = e^T S^-1 e, chi-square with 2 degrees of freedom when the covariances are
+//   right (median 1.39, 1 % above 9.21). Median and fraction above 9.21.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -45,5 +51,16 @@ struct Jump {
 };
 
 Jump max_jump(const std::vector<Pose2>& est, const std::vector<Pose2>& ref);
+
+struct StepConsistency {
+  std::size_t steps = 0;              // steps whose two poses carry a positive definite covariance
+  std::optional<double> nees_median;  // [unitless] nullopt without such steps
+  std::optional<double> outside_99_fraction;  // [unitless, 0 to 1] NEES above 9.21
+};
+
+// `cov[i]`: covariance of est[i] in the frame est is expressed in (zero: unknown, skipped).
+StepConsistency step_consistency(const std::vector<Pose2>& est,
+                                 const std::vector<Eigen::Matrix3d>& cov,
+                                 const std::vector<Pose2>& ref);
 
 }  // namespace traverse::evaluator

@@ -85,7 +85,9 @@ void PoseCollector::add_estimate(const std::string& type_name, const void* data,
         ++non_finite_poses_;
         return;
       }
-      pose2d_estimate_.push_back({m.utime, Pose2(m.x, m.y, m.theta)});
+      StampedPose p{m.utime, Pose2(m.x, m.y, m.theta)};
+      for (int i = 0; i < 9; ++i) p.covariance(i / 3, i % 3) = m.covariance[i];  // row-major
+      pose2d_estimate_.push_back(p);
       return;
     }
     case EstimateType::kKeyPoses: {

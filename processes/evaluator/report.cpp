@@ -142,7 +142,10 @@ void add_evaluation(const Evaluation& ev, JsonLine& json) {
       .add("rpe_10m_m", ev.rpe_10m.rms_m)
       .add_int("rpe_1m_pairs", static_cast<long long>(ev.rpe_1m.pairs))
       .add_int("rpe_10m_pairs", static_cast<long long>(ev.rpe_10m.pairs))
-      .add("max_jump_m", figure(ev.max_jump.step_error_m));
+      .add("max_jump_m", figure(ev.max_jump.step_error_m))
+      .add("step_nees_median", ev.step_consistency.nees_median)
+      .add("step_outside_99_fraction", ev.step_consistency.outside_99_fraction)
+      .add_int("step_nees_steps", static_cast<long long>(ev.step_consistency.steps));
   if (ev.samples.size() >= 2) {
     const int64_t t0 = ev.samples.front().utime;
     json.add("max_jump_time_s",

@@ -5,6 +5,7 @@
 // reference never invents errors: such estimates are counted as unmatched.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -16,6 +17,9 @@ namespace traverse::evaluator {
 struct StampedPose {
   int64_t utime = 0;  // [us] time the pose is valid at
   Pose2 pose;         // T_world_base (reference) or T_map_base (estimate)
+  // Of (x [m], y [m], theta [rad]) in the pose's parent frame, as the pose message carried it;
+  // zero when unknown (ground truth, key poses whose marginals are correlated with each other).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
 using Trajectory = std::vector<StampedPose>;
