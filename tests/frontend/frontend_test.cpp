@@ -256,6 +256,11 @@ TEST(Frontend, ShippedConfigLoadsAndIsUsable) {
   FrontendConfig config;
   load_config("configs/frontend.yaml", config);
   EXPECT_EQ(config_problem(config), std::nullopt);
+  FrontendConfig negative_temperature = config;
+  negative_temperature.matcher.wide_search_temperature = -1.0;
+  const auto problem = config_problem(negative_temperature);
+  ASSERT_NE(problem, std::nullopt);
+  EXPECT_NE(problem->find("matcher.wide_search_temperature"), std::string::npos) << *problem;
   config.map.levels = 0;
   EXPECT_NE(config_problem(config), std::nullopt);
 }
