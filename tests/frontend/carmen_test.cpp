@@ -1,11 +1,11 @@
 // The frontend on the four real CARMEN logs (SICK, 180 beams, no odometry, no IMU), configured by
 // configs/frontend.yaml, compared with each log's corrected reference trajectory: relative pose
 // error over 1 m and 10 m of travel, and the largest jump (step of the estimate beyond the
-// reference's step), the same figures traverse-evaluator reports (rpe_1m_m, rpe_10m_m, max_jump_m).
+// reference's step), and each step's error against the reported covariances: computed by the
+// evaluator's library, so the same figures scripts/eval-carmen.sh NAME --stages frontend reports
+// (rpe_1m_m, rpe_10m_m, max_jump_m, step_nees_median, step_outside_99_fraction).
 #include <gtest/gtest.h>
 
-#include <Eigen/LU>
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +13,7 @@
 #include "carmen_log.hpp"
 #include "carmen_node.hpp"
 #include "config.hpp"
+#include "evaluator.hpp"
 #include "frontend.hpp"
 #include "scan_message.hpp"
 
@@ -23,48 +24,8 @@ struct Metrics {
   int scans = 0;
   int predicted = 0;
   int searched = 0;
-  double rpe_1m_m = 0.0, rpe_10m_m = 0.0, max_jump_m = 0.0;
-  // Each step's translation error against the reported covariances: the squared Mahalanobis
-  // distance (NEES, chi-square with 2 degrees of freedom if the covariances are right: median
-  // 1.39, 1 % above 9.21). Its median, and the fraction of steps above 9.21.
-  double nees_median = 0.0, outside_99_fraction = 0.0;
-  int steps_off = 0, steps_off_inside_99 = 0;  // steps more than 0.3 m off; those inside 9.21
+  evaluator::Evaluation ev;  // as traverse-evaluator computes it (rpe, max_jump, step NEES)
 };
-
-// Covariance of the step from pose a to pose b, in a's frame (x, y): both poses' position
-// covariances (map frame, as the frontend reports them) rotated into a's frame, and a's heading
-// variance swinging the step. Cross terms are left out (the frontend reports none between poses).
-Eigen::Matrix2d step_covariance(const Pose2& a, const Eigen::Matrix3d& cov_a, const Pose2& b,
-                                const Eigen::Matrix3d& cov_b) {
-  const Eigen::Matrix2d R = a.rotation();
-  const Eigen::Vector2d step = between(a, b).translation();
-  const Eigen::Vector2d swing(step.y(), -step.x());  // d(step)/d(theta_a)
-  return R.transpose() * (cov_a.topLeftCorner<2, 2>() + cov_b.topLeftCorner<2, 2>()) * R +
-         cov_a(2, 2) * swing * swing.transpose();
-}
-
-// RMS translational error of the relative motion over `distance_m` of reference travel.
-double relative_pose_error(const std::vector<Pose2>& ref, const std::vector<Pose2>& est,
-                           double distance_m) {
-  std::vector<double> travelled{0.0};
-  for (std::size_t i = 1; i < ref.size(); ++i) {
-    travelled.push_back(travelled.back() +
-                        (ref[i].translation() - ref[i - 1].translation()).norm());
-  }
-  double sum = 0.0;
-  int n = 0;
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < ref.size(); ++i) {
-    j = std::max(j, i + 1);
-    while (j < ref.size() && travelled[j] - travelled[i] < distance_m) ++j;
-    if (j >= ref.size()) break;
-    const Eigen::Vector2d e =
-        between(ref[i], ref[j]).translation() - between(est[i], est[j]).translation();
-    sum += e.squaredNorm();
-    ++n;
-  }
-  return n > 0 ? std::sqrt(sum / n) : 0.0;
-}
 
 Metrics run_log(const std::string& path) {
   carmen::Reader reader(path);
@@ -72,8 +33,7 @@ Metrics run_log(const std::string& path) {
   FrontendConfig config;
   load_config("configs/frontend.yaml", config);
   Frontend frontend(config);
-  std::vector<Pose2> ref, est;
-  std::vector<Eigen::Matrix3d> cov;
+  evaluator::Trajectory ref, est;
   Metrics m;
   // The scans as traverse-carmen publishes them (configs/carmen.yaml defaults) and
   // traverse-frontend reads them: the same figures as scripts/eval-carmen.sh --stages frontend.
@@ -84,39 +44,20 @@ Metrics run_log(const std::string& path) {
     if (r.status == ScanStatus::kDropped) continue;
     if (r.status == ScanStatus::kPredicted) ++m.predicted;
     if (r.searched) ++m.searched;
-    ref.emplace_back(s->x_m, s->y_m, s->theta_rad);
-    est.push_back(r.T_map_base);
-    cov.push_back(r.covariance);
+    ref.push_back({r.utime, Pose2(s->x_m, s->y_m, s->theta_rad)});
+    est.push_back({r.utime, r.T_map_base, r.covariance});
     // CARMEN_TRACE=1: every step, reference against estimate, to find where tracking fails.
     if (std::getenv("CARMEN_TRACE") && ref.size() > 1) {
       const std::size_t i = ref.size() - 1;
-      const Pose2 dr = between(ref[i - 1], ref[i]), de = between(est[i - 1], est[i]);
+      const Pose2 dr = between(ref[i - 1].pose, ref[i].pose);
+      const Pose2 de = between(est[i - 1].pose, est[i].pose);
       std::printf("TRACE %zu ref %.3f %.3f %.1f est %.3f %.3f %.1f err %.3f res %.3f\n", i, dr.x(),
                   dr.y(), dr.theta() * 57.3, de.x(), de.y(), de.theta() * 57.3,
                   (dr.translation() - de.translation()).norm(), r.residual_rms);
     }
   }
   m.scans = static_cast<int>(est.size());
-  std::vector<double> nees;
-  for (std::size_t i = 1; i < est.size(); ++i) {
-    const Eigen::Vector2d e =
-        between(ref[i - 1], ref[i]).translation() - between(est[i - 1], est[i]).translation();
-    m.max_jump_m = std::max(m.max_jump_m, e.norm());
-    nees.push_back(e.dot(step_covariance(est[i - 1], cov[i - 1], est[i], cov[i]).inverse() * e));
-    if (e.norm() > 0.3) {
-      ++m.steps_off;
-      if (nees.back() <= 9.21) ++m.steps_off_inside_99;
-    }
-  }
-  if (!nees.empty()) {
-    m.outside_99_fraction = static_cast<double>(std::count_if(nees.begin(), nees.end(),
-                                                              [](double d) { return d > 9.21; })) /
-                            static_cast<double>(nees.size());
-    std::nth_element(nees.begin(), nees.begin() + nees.size() / 2, nees.end());
-    m.nees_median = nees[nees.size() / 2];
-  }
-  m.rpe_1m_m = relative_pose_error(ref, est, 1.0);
-  m.rpe_10m_m = relative_pose_error(ref, est, 10.0);
+  m.ev = evaluator::evaluate(est, ref, evaluator::EvaluatorConfig{});
   return m;
 }
 
@@ -139,22 +80,26 @@ TEST_P(CarmenLog, TracksReference) {
   const std::string path = std::string("../shared/data/carmen/") + c.name + "-corrected.log.gz";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no data at " << path;
   const Metrics m = run_log(path);
+  const evaluator::Evaluation& ev = m.ev;
+  ASSERT_EQ(ev.matched, static_cast<std::size_t>(m.scans));
+  ASSERT_TRUE(ev.rpe_10m.rms_m && ev.step_consistency.nees_median);
+  const double rpe_1m = *ev.rpe_1m.rms_m, rpe_10m = *ev.rpe_10m.rms_m;
+  const double nees_median = *ev.step_consistency.nees_median;
+  const double outside_99 = *ev.step_consistency.outside_99_fraction;
   std::printf(
       "%s: %d scans, %d predicted, %d searched, rpe_1m %.4f m, rpe_10m %.4f m, max_jump %.4f m, "
-      "step NEES median %.2f, outside the 99 %% ellipse %.1f %%, steps over 0.3 m off %d (%d "
-      "inside "
-      "it)\n",
-      c.name, m.scans, m.predicted, m.searched, m.rpe_1m_m, m.rpe_10m_m, m.max_jump_m,
-      m.nees_median, 100.0 * m.outside_99_fraction, m.steps_off, m.steps_off_inside_99);
+      "step NEES median %.2f, outside the 99 %% ellipse %.1f %%\n",
+      c.name, m.scans, m.predicted, m.searched, rpe_1m, rpe_10m, ev.max_jump.step_error_m,
+      nees_median, 100.0 * outside_99);
   EXPECT_GT(m.scans, c.min_scans);
   EXPECT_EQ(m.predicted, 0);
-  EXPECT_LT(m.rpe_1m_m, c.max_rpe_1m_m);
-  EXPECT_LT(m.rpe_10m_m, c.max_rpe_10m_m);
-  EXPECT_LT(m.max_jump_m, c.max_jump_m);
+  EXPECT_LT(rpe_1m, c.max_rpe_1m_m);
+  EXPECT_LT(rpe_10m, c.max_rpe_10m_m);
+  EXPECT_LT(ev.max_jump.step_error_m, c.max_jump_m);
   if (c.max_outside_99_fraction >= 0.0) {
-    EXPECT_LT(m.outside_99_fraction, c.max_outside_99_fraction);
-    EXPECT_GT(m.nees_median, 0.1);
-    EXPECT_LT(m.nees_median, 1.39);
+    EXPECT_LT(outside_99, c.max_outside_99_fraction);
+    EXPECT_GT(nees_median, 0.1);
+    EXPECT_LT(nees_median, 1.39);
   }
 }
 
