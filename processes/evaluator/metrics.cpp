@@ -8,11 +8,16 @@
 namespace traverse::evaluator {
 namespace {
 
-// Translational part of the difference between two relative motions.
+// Estimated minus true translation of the motion from a to b, each in its own start pose's frame.
+Eigen::Vector2d step_translation_error(const Pose2& ref_a, const Pose2& ref_b, const Pose2& est_a,
+                                       const Pose2& est_b) {
+  return between(est_a, est_b).translation() - between(ref_a, ref_b).translation();
+}
+
+// Length of the difference between two relative motions' translations.
 double relative_translation_error(const Pose2& ref_a, const Pose2& ref_b, const Pose2& est_a,
                                   const Pose2& est_b) {
-  const Pose2 error = between(between(ref_a, ref_b), between(est_a, est_b));
-  return error.translation().norm();
+  return step_translation_error(ref_a, ref_b, est_a, est_b).norm();
 }
 
 }  // namespace
@@ -73,7 +78,7 @@ StepConsistency step_consistency(const std::vector<Pose2>& est,
     if (cov[k - 1].isZero() || cov[k].isZero()) continue;
     const Pose2& a = est[k - 1];
     const Eigen::Vector2d step = between(a, est[k]).translation();
-    const Eigen::Vector2d e = between(ref[k - 1], ref[k]).translation() - step;
+    const Eigen::Vector2d e = step_translation_error(ref[k - 1], ref[k], a, est[k]);
     const Eigen::Matrix2d R = a.rotation();
     const Eigen::Vector2d swing(step.y(), -step.x());  // d(step) / d(theta_a)
     const Eigen::Matrix2d S =
