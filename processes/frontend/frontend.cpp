@@ -19,6 +19,21 @@ constexpr int64_t kImuStaleUs = 500'000;
 constexpr double kVelocitySmoothingS = 0.1;
 // Weight of the newest step in the average step of sparse scans (see update_motion()).
 constexpr double kSparseStepSmoothing = 0.3;
+// Two members' steps agree when they differ by less than this (about three times what a
+// member's steps scatter where all are right, a tenth of a typical sparse step).
+constexpr double kAgreeM = 0.15, kAgreeRad = 0.05;
+// This many scans in a row that are not sparse make a scanner's stream: the ensemble is dropped
+// (on the CARMEN logs every scan after the first is sparse; a stream pays for three scans).
+constexpr int kDenseScansEndingEnsemble = 3;
+
+// Offset of ensemble member k (1, 2, ...) from the initial pose: fractions of a cell of
+// `cell_m` in x and y and up to a degree of heading, from an additive recurrence of irrational
+// steps (spread evenly, the same every run).
+Pose2 member_offset(int k, double cell_m) {
+  const auto frac = [](double v) { return v - std::floor(v); };
+  return Pose2(cell_m * frac(k * 0.6180339887), cell_m * frac(k * 0.7548776662),
+               (2.0 * frac(k * 0.5698402910) - 1.0) * M_PI / 180.0);
+}
 
 Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
@@ -27,7 +42,34 @@ Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
       .toRotationMatrix();
 }
 
+bool agrees(const Pose2& a, const Pose2& b) {
+  return (a.translation() - b.translation()).norm() < kAgreeM &&
+         std::abs(wrap_angle(a.theta() - b.theta())) < kAgreeRad;
+}
+
 }  // namespace
+
+StepVote vote_on_steps(const std::vector<Pose2>& steps, const Eigen::Matrix2d& R_map_last) {
+  StepVote v;
+  if (steps.empty()) return v;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    int support = 0;
+    for (const Pose2& other : steps) support += agrees(steps[i], other) ? 1 : 0;
+    if (support > v.support) {
+      v.support = support;
+      v.chosen = i;
+    }
+  }
+  const Pose2& step = steps[v.chosen];
+  for (const Pose2& other : steps) {
+    Eigen::Vector3d d;
+    d.head<2>() = R_map_last * (other.translation() - step.translation());
+    d.z() = wrap_angle(other.theta() - step.theta());
+    v.spread += d * d.transpose();
+  }
+  v.spread /= static_cast<double>(steps.size());
+  return v;
+}
 
 Frontend::Frontend(const FrontendConfig& config)
     : config_(config),
@@ -35,7 +77,20 @@ Frontend::Frontend(const FrontendConfig& config)
                     config.T_base_laser.theta_rad),
       map_(config.map),
       yaw_(rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
-                        config.deskew.imu_yaw_rad)) {}
+                        config.deskew.imu_yaw_rad)) {
+  if (config.matcher.sparse_ensemble_members <= 1) return;
+  // The members' grids are offset by fractions of a cell of the wide search's level.
+  const double cell_m = config.map.resolution_m * std::pow(2.0, std::min(1, config.map.levels - 1));
+  for (int k = 1; k < config.matcher.sparse_ensemble_members; ++k) {
+    FrontendConfig member = config;
+    member.matcher.sparse_ensemble_members = 1;
+    const Pose2 offset = member_offset(k, cell_m);
+    member.initial_pose.x_m += offset.x();
+    member.initial_pose.y_m += offset.y();
+    member.initial_pose.theta_rad += offset.theta();
+    members_.push_back(std::make_unique<Frontend>(member));
+  }
+}
 
 void Frontend::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) {
   if (!angular_velocity_imu.allFinite() || !yaw_.add(utime, angular_velocity_imu)) {
@@ -210,6 +265,65 @@ bool Frontend::map_update_due(const Pose2& T_map_base) const {
 }
 
 FrontendResult Frontend::process(const Scan& scan) {
+  FrontendResult result = process_own(scan);
+  if (config_.matcher.sparse_ensemble_members <= 1) return result;
+  std::vector<FrontendResult> member_results;
+  member_results.reserve(members_.size());
+  for (auto& m : members_) member_results.push_back(m->process(scan));
+  if (result.status == ScanStatus::kDropped) return result;
+  vote(result, member_results);
+  dense_in_a_row_ = result.sparse ? 0 : dense_in_a_row_ + 1;
+  if (dense_in_a_row_ >= kDenseScansEndingEnsemble && !members_.empty()) {
+    members_.clear();
+    own_last_.resize(1);
+  }
+  return result;
+}
+
+void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& member_results) {
+  // own_last_[0] is this frontend's last own pose, own_last_[k] member k's; a member without a
+  // pose for this scan does not vote.
+  std::vector<const FrontendResult*> results{&result};
+  for (const FrontendResult& r : member_results) results.push_back(&r);
+  if (own_last_.empty()) {  // the first pose: the initial pose, published as it is
+    for (const FrontendResult* r : results) own_last_.push_back(r->T_map_base);
+    T_published_last_ = result.T_map_base;
+    return;
+  }
+  std::vector<Pose2> steps;
+  std::vector<std::size_t> voters;
+  for (std::size_t k = 0; k < results.size() && k < own_last_.size(); ++k) {
+    if (results[k]->status == ScanStatus::kDropped) continue;
+    steps.push_back(between(own_last_[k], results[k]->T_map_base));
+    voters.push_back(k);
+  }
+  const StepVote v = vote_on_steps(steps, T_published_last_.rotation());
+  const FrontendResult& c = *results[voters[v.chosen]];
+  const Pose2& step = steps[v.chosen];
+  const Pose2 published = T_published_last_ * step;
+  // The chosen member's covariance, turned from its map frame into the published one, plus the
+  // spread of all members' steps about the chosen step.
+  const double turn = wrap_angle(published.theta() - c.T_map_base.theta());
+  Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
+  J.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(turn).toRotationMatrix();
+  const Eigen::Matrix3d covariance = J * c.covariance * J.transpose() + v.spread;
+  const Pose2 predicted =
+      T_published_last_ * between(own_last_[voters[v.chosen]], c.T_map_base_predicted);
+
+  if (v.support < static_cast<int>(steps.size())) ++counters_.steps_disputed;
+  if (!agrees(steps[0], step)) ++counters_.steps_outvoted;
+  for (std::size_t i = 0; i < voters.size(); ++i) {
+    own_last_[voters[i]] = results[voters[i]]->T_map_base;
+  }
+  result.T_map_base = published;
+  result.T_map_base_predicted = predicted;
+  result.covariance = covariance;
+  result.ensemble_agreeing = v.support;
+  result.ensemble_voting = static_cast<int>(steps.size());
+  T_published_last_ = published;
+}
+
+FrontendResult Frontend::process_own(const Scan& scan) {
   ++counters_.scans_received;
   FrontendResult result;
   result.utime = scan.utime_last;
@@ -226,6 +340,7 @@ FrontendResult Frontend::process(const Scan& scan) {
   const bool use_imu = imu_active(scan);
   result.imu_used = use_imu;
   const bool sparse_scan = initialised_ && sparse(scan.utime_last);
+  result.sparse = sparse_scan;
 
   if (static_cast<int>(points.size()) < config_.matcher.min_valid_points) {
     ++counters_.scans_predicted;
@@ -238,9 +353,10 @@ FrontendResult Frontend::process(const Scan& scan) {
 
   result.status = ScanStatus::kMatched;
   if (!initialised_) {
-    // The first scan defines the map frame: the pose is exact by definition.
+    // The first scan's pose is given (initial_pose, the identity by default): exact by definition.
     deskew(points, utimes, scan.utime_last, use_imu);
-    result.T_map_base = Pose2();
+    result.T_map_base =
+        Pose2(config_.initial_pose.x_m, config_.initial_pose.y_m, config_.initial_pose.theta_rad);
     result.covariance = Eigen::Matrix3d::Identity() * 1e-12;
     result.matched_points = static_cast<int>(points.size());
   } else {

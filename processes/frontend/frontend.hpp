@@ -10,6 +10,9 @@
 //   4. match the points against the map pyramid, coarse to fine, from the prediction (sparse
 //      scans: from the best pose of a wide correlative search around it);
 //   5. update the map when the pose moved or turned past a threshold since the last update.
+// Sparse scans go through this pipeline in several frontends at once (an ensemble, see
+// MatcherConfig::sparse_ensemble_members), each with its own map on a grid offset by a fraction
+// of a cell; the published pose is the previous one times the step most of them agree on.
 // A scan with too few valid points, or whose match on a scanner's stream lands far from the
 // prediction with a poor fit, gets the predicted pose (flagged); a scan whose time does not
 // advance, or whose last point is before its first, is dropped. Each case is counted.
@@ -18,6 +21,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -32,7 +36,7 @@ namespace traverse::frontend {
 using Scan = PlanarScan;
 
 enum class ScanStatus {
-  kMatched,    // pose measured by matching (the first scan: pose defines the map frame)
+  kMatched,    // pose measured by matching (the first scan: its pose is the config's initial_pose)
   kPredicted,  // pose predicted from motion: too few valid points, or an unverified match
   kDropped,    // time does not advance or is inconsistent: no pose
 };
@@ -50,6 +54,10 @@ struct FrontendResult {
   int iterations = 0;
   double residual_rms = 0.0;  // [unitless] RMS of 1 - M at the result
   bool searched = false;      // the matcher needed its recovery search
+  bool sparse = false;        // matched as a sparse scan (wide search)
+  // Sparse-scan ensemble (matcher.sparse_ensemble_members): members whose step agrees with the
+  // published one, of how many voted; 0 of 0 without an ensemble.
+  int ensemble_agreeing = 0, ensemble_voting = 0;
 };
 
 struct FrontendCounters {
@@ -64,7 +72,20 @@ struct FrontendCounters {
   int64_t map_tiles_evicted = 0;
   int64_t imu_samples = 0;
   int64_t imu_dropped_time = 0;  // IMU samples not after the previous one
+  int64_t steps_disputed = 0;    // sparse ensemble: steps on which not every member agreed
+  int64_t steps_outvoted = 0;    // ... on which this frontend's own step lost the vote
 };
+
+// The vote of a sparse-scan ensemble on one step (each member's step from its last pose to its
+// new one, in its own map): the step with the most steps within 0.15 m and 0.05 rad of it (on a
+// tie the earliest), how many those are, and the second moment of all steps about it (x, y in
+// the frame `R_map_last` turns them into, [m^2, rad^2]).
+struct StepVote {
+  std::size_t chosen = 0;
+  int support = 0;
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+};
+StepVote vote_on_steps(const std::vector<Pose2>& steps, const Eigen::Matrix2d& R_map_last);
 
 class Frontend {
  public:
@@ -75,6 +96,8 @@ class Frontend {
   // Time of the newest IMU sample, if any arrived.
   std::optional<int64_t> last_imu_utime() const;
 
+  // One pose per scan (status kDropped: none). With a sparse-scan ensemble, the pose is the
+  // previous one times the step most members agree on (see MatcherConfig).
   FrontendResult process(const Scan& scan);
 
   const FrontendCounters& counters() const { return counters_; }
@@ -82,6 +105,11 @@ class Frontend {
   const FrontendConfig& config() const { return config_; }
 
  private:
+  // The pipeline of one frontend: its own pose in its own map.
+  FrontendResult process_own(const Scan& scan);
+  // Votes on the step from the last pose among this frontend and the ensemble's members;
+  // `result` (this frontend's own) becomes the published pose.
+  void vote(FrontendResult& result, const std::vector<FrontendResult>& member_results);
   // Valid readings as points in the base frame with their times; counts invalid ones.
   void valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& points_base,
                     std::vector<int64_t>& utimes);
@@ -118,6 +146,14 @@ class Frontend {
   static constexpr std::size_t kRecentIntervals = 5;
   std::array<int64_t, kRecentIntervals> recent_intervals_us_{};
   std::size_t interval_count_ = 0;
+
+  // Sparse-scan ensemble: the other members (each a frontend of one, its grid offset), and the
+  // last own pose of this frontend and of each member; the last published pose; how many scans
+  // in a row were not sparse (three drop the members: a scanner's stream).
+  std::vector<std::unique_ptr<Frontend>> members_;
+  std::vector<Pose2> own_last_;
+  Pose2 T_published_last_;
+  int dense_in_a_row_ = 0;
 
   // Reused between scans: beam directions of the last scan geometry, and point buffers.
   std::size_t beam_n_ = 0;

@@ -2,6 +2,7 @@
 // keys listed once in each `visit`. Lengths m, angles rad, times us.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -83,6 +84,17 @@ struct MatcherConfig {
   // their 99 % ellipse: the errors have heavier tails (tests/frontend/carmen_test.cpp). 0 leaves
   // the spread out.
   double wide_search_temperature = 3.0;
+  // Sparse scans are matched by this many frontends at once, each with its own map whose grid
+  // is offset from the others' by a fraction of a cell and turned by under a degree; each scan's
+  // published step is the one most of them agree on (within 0.15 m and 0.05 rad), and the spread
+  // of their steps is added to its covariance. On a sparse log the outcome of one frontend turns
+  // on such offsets: on CARMEN aces, from 8 offsets, one frontend jumps 0.54 to 2.6 m and 5 times
+  // loses track (RPE over 10 m 1.9 to 2.7 m); the members mostly go wrong at different scans, and
+  // five of them jump 0.23 to 1.56 m with RPE over 10 m at most 0.47 m
+  // (scripts/frontend-sensitivity.sh aces, --members 1). Steps most members misjudge together
+  // remain. Costs this many times the sparse path's time; a scanner's stream (three scans in a
+  // row that are not sparse) drops the extra members. 1 runs one frontend.
+  int sparse_ensemble_members = 5;
 
   template <class V>
   void visit(V& v) {
@@ -104,6 +116,7 @@ struct MatcherConfig {
     v("wide_search_linear_window_m", wide_search_linear_window_m);
     v("wide_search_angular_window_rad", wide_search_angular_window_rad);
     v("wide_search_temperature", wide_search_temperature);
+    v("sparse_ensemble_members", sparse_ensemble_members);
   }
 };
 
@@ -129,7 +142,7 @@ struct DeskewConfig {
   }
 };
 
-// A planar extrinsic T_parent_child.
+// A planar pose T_parent_child: an extrinsic, or a pose in the map frame.
 struct Extrinsic2Config {
   double x_m = 0.0;
   double y_m = 0.0;
@@ -148,6 +161,11 @@ struct FrontendConfig {
   std::string imu_channel = channels::kImu;
   std::string pose_channel = channels::kPoseFrontend;
   Extrinsic2Config T_base_laser;
+  // Pose of the base at the first scan in the map frame, T_map_base: where the trajectory starts
+  // in a site's frame (a surveyed start point). The map's grid is aligned with the map frame, so
+  // a sub-cell offset or a small turn here also changes how every scan falls on the cells
+  // (scripts/frontend-sensitivity.sh measures what that does to a trajectory).
+  Extrinsic2Config initial_pose;
   MapConfig map;
   MatcherConfig matcher;
   DeskewConfig deskew;
@@ -158,6 +176,7 @@ struct FrontendConfig {
     v("imu_channel", imu_channel);
     v("pose_channel", pose_channel);
     v("T_base_laser", T_base_laser);
+    v("initial_pose", initial_pose);
     v("map", map);
     v("matcher", matcher);
     v("deskew", deskew);
@@ -166,6 +185,9 @@ struct FrontendConfig {
 
 // The values a frontend cannot run with, named; nullopt when the config is usable.
 inline std::optional<std::string> config_problem(const FrontendConfig& c) {
+  if (!(std::isfinite(c.initial_pose.x_m) && std::isfinite(c.initial_pose.y_m) &&
+        std::isfinite(c.initial_pose.theta_rad)))
+    return "initial_pose must be finite";
   if (!(c.map.resolution_m >= 0.005)) return "map.resolution_m must be at least 0.005";
   if (c.map.levels < 1 || c.map.levels > 8) return "map.levels must be 1 to 8";
   if (!(c.map.p_occupied > 0.5 && c.map.p_occupied < 1.0))
@@ -188,6 +210,8 @@ inline std::optional<std::string> config_problem(const FrontendConfig& c) {
     return "matcher.wide_search_linear_window_m must be positive and "
            "wide_search_angular_window_rad in (0, pi]";
   if (c.matcher.wide_search_gap_us <= 0) return "matcher.wide_search_gap_us must be positive";
+  if (c.matcher.sparse_ensemble_members < 1 || c.matcher.sparse_ensemble_members > 16)
+    return "matcher.sparse_ensemble_members must be 1 to 16";
   if (!(c.matcher.wide_search_temperature >= 0.0))
     return "matcher.wide_search_temperature must not be negative";
   return std::nullopt;

@@ -67,6 +67,8 @@ void FrontendNode::report_counters() {
   counters_("map_bytes", static_cast<double>(frontend_.map().memory_bytes()));
   counters_("imu_samples", static_cast<double>(c.imu_samples));
   counters_("imu_dropped", static_cast<double>(c.imu_dropped_time));
+  counters_("steps_disputed", static_cast<double>(c.steps_disputed));
+  counters_("steps_outvoted", static_cast<double>(c.steps_outvoted));
 }
 
 }  // namespace traverse::frontend

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 
@@ -27,6 +28,7 @@ synthetic::SweepSpec small_sweep(int64_t utime_first) {
 struct RoomRun {
   double position_error_m = 0.0, heading_error_rad = 0.0;
   FrontendCounters counters;
+  int last_voting = 0;  // ensemble members voting on the last step
 };
 RoomRun run_room(const FrontendConfig& config, bool with_imu, double turn_rate, int scans = 120) {
   const auto world = synthetic::room();
@@ -54,10 +56,16 @@ RoomRun run_room(const FrontendConfig& config, bool with_imu, double turn_rate, 
     }
     const FrontendResult r = frontend.process(scan);
     EXPECT_EQ(r.status, ScanStatus::kMatched);
-    if (k == 0) T_map_world = truth(scan.utime_last).inverse();
+    if (k == 0) {
+      const auto& p = config.initial_pose;
+      T_map_world = Pose2(p.x_m, p.y_m, p.theta_rad) * truth(scan.utime_last).inverse();
+      EXPECT_NEAR((r.T_map_base.translation() - Eigen::Vector2d(p.x_m, p.y_m)).norm(), 0.0, 1e-12);
+      EXPECT_NEAR(wrap_angle(r.T_map_base.theta() - p.theta_rad), 0.0, 1e-12);
+    }
     const Pose2 T_map_base_true = T_map_world * truth(scan.utime_last);
     run.position_error_m = (r.T_map_base.translation() - T_map_base_true.translation()).norm();
     run.heading_error_rad = std::abs(wrap_angle(r.T_map_base.theta() - T_map_base_true.theta()));
+    run.last_voting = r.ensemble_voting;
   }
   run.counters = frontend.counters();
   return run;
@@ -79,6 +87,50 @@ TEST(Frontend, TracksWithoutImu) {
   EXPECT_EQ(run.counters.imu_samples, 0);
 }
 
+// A scanner's stream is matched by one frontend: the sparse-scan ensemble votes on its first
+// scans only, then is dropped.
+TEST(Frontend, ScannerStreamDropsTheSparseEnsemble) {
+  FrontendConfig config;
+  config.matcher.sparse_ensemble_members = 4;
+  const RoomRun run = run_room(config, false, 0.4, 30);
+  EXPECT_EQ(run.last_voting, 1);
+  EXPECT_LT(run.position_error_m, 0.005);
+  EXPECT_EQ(run.counters.steps_outvoted, 0);
+}
+
+// The step most members agree on wins; the spread of the others is in the covariance it adds.
+TEST(StepVote, MajorityWinsAndItsSpreadCoversTheRest) {
+  const std::vector<Pose2> steps{{0.40, 0.0, 0.10},
+                                 {1.00, 0.0, 0.10},
+                                 {1.05, 0.02, 0.11},
+                                 {0.97, -0.03, 0.09},
+                                 {1.00, 0.0, 0.60}};
+  // The last pose faces +y: a step's x is the map's y.
+  const StepVote v = vote_on_steps(steps, Eigen::Rotation2Dd(M_PI / 2).toRotationMatrix());
+  EXPECT_EQ(v.support, 3);
+  EXPECT_TRUE(v.chosen >= 1 && v.chosen <= 3) << v.chosen;
+  // The 0.6 m shorter step and the 0.5 rad turn of the two outvoted steps.
+  EXPECT_GT(v.spread(1, 1), 0.6 * 0.6 / 5 * 0.8);
+  EXPECT_LT(v.spread(0, 0), 0.01);
+  EXPECT_GT(v.spread(2, 2), 0.5 * 0.5 / 5 * 0.8);
+  // No majority: the first step (the frontend's own) stands.
+  const StepVote tie =
+      vote_on_steps({{0.4, 0.0, 0.0}, {1.0, 0.0, 0.0}}, Eigen::Matrix2d::Identity());
+  EXPECT_EQ(tie.chosen, 0u);
+  EXPECT_EQ(tie.support, 1);
+  EXPECT_NEAR(tie.spread(0, 0), 0.6 * 0.6 / 2, 1e-12);
+}
+
+// The trajectory starts at the configured pose, off the grid's cells by a fraction of one and
+// turned, and is tracked as well from there.
+TEST(Frontend, TracksFromTheConfiguredInitialPose) {
+  FrontendConfig config;
+  config.initial_pose = {12.337, -4.061, 2.2};
+  const RoomRun run = run_room(config, false, 0.4);
+  EXPECT_LT(run.position_error_m, 0.005);
+  EXPECT_LT(run.heading_error_rad, 0.001);
+}
+
 // Turning fast (1.5 rad/s, a turn on the spot's pace): de-skew removes the error that the sweep's
 // own rotation puts into every scan and, through map updates, into the map.
 TEST(Frontend, DeskewReducesErrorWhileTurningFast) {
@@ -98,6 +150,7 @@ TEST(Frontend, DeskewReducesErrorWhileTurningFast) {
 struct SparseRun {
   double max_position_error_m = 0.0, max_heading_error_rad = 0.0;
   int matched = 0;
+  int min_voting = 1 << 20;  // fewest ensemble members voting on a step (after the first scan)
 };
 // Pose k of a sparse log in the room (scans 3 s apart).
 Pose2 sparse_truth(int k) {
@@ -128,6 +181,7 @@ SparseRun run_sparse(const FrontendConfig& config, const std::vector<int64_t>& t
         world, [&](int64_t) { return T; }, Pose2(), spec, &rng);
     const FrontendResult r = frontend.process(scan);
     if (r.status == ScanStatus::kMatched) ++run.matched;
+    if (k > 0) run.min_voting = std::min(run.min_voting, r.ensemble_voting);
     if (k == 0) T_map_world = T.inverse();
     const Pose2 T_map_base_true = T_map_world * T;
     run.max_position_error_m =
@@ -156,6 +210,7 @@ TEST(Frontend, TracksSparseScansWithLargeTurns) {
   load_config("configs/frontend.yaml", config);
   const SparseRun run = run_sparse(config);
   EXPECT_EQ(run.matched, 18);
+  EXPECT_EQ(run.min_voting, config.matcher.sparse_ensemble_members);
   EXPECT_LT(run.max_position_error_m, 0.05);
   EXPECT_LT(run.max_heading_error_rad, 0.01);
   // The same scans with the wide search switched off (gap threshold beyond the scans' 3 s): the
@@ -261,6 +316,11 @@ TEST(Frontend, ShippedConfigLoadsAndIsUsable) {
   const auto problem = config_problem(negative_temperature);
   ASSERT_NE(problem, std::nullopt);
   EXPECT_NE(problem->find("matcher.wide_search_temperature"), std::string::npos) << *problem;
+  FrontendConfig nan_start = config;
+  nan_start.initial_pose.theta_rad = std::numeric_limits<double>::quiet_NaN();
+  const auto start_problem = config_problem(nan_start);
+  ASSERT_NE(start_problem, std::nullopt);
+  EXPECT_NE(start_problem->find("initial_pose"), std::string::npos) << *start_problem;
   config.map.levels = 0;
   EXPECT_NE(config_problem(config), std::nullopt);
 }

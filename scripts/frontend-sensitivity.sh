@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# scripts/frontend-sensitivity.sh NAME|PATH [--starts N] [--members M]
+#
+# How much the frontend's trajectory on a real CARMEN log owes to where the map's grid cells
+# happen to fall. Runs traverse-frontend offline N times on the log (converted as
+# scripts/eval-carmen.sh does), each time with the first pose (the config's initial_pose) moved by
+# a fraction of a cell of the wide search's grid (0 to 0.1 m in x and y) and turned by up to one
+# degree: the same scans and the same algorithm, only the discretisation differs. Each trajectory
+# is evaluated against the log's reference with traverse-evaluator (relative figures: the start
+# does not enter them). Start 0 is the shipped config, so its figures are those of
+# scripts/eval-carmen.sh NAME --stages frontend --offline. The starts are a fixed low-discrepancy
+# sequence: the same N gives the same figures every time.
+# Outputs under out/sensitivity/carmen-NAME/ (one directory per start: config, recorded log,
+# evaluator outputs); prints one line per start and, last, one JSON object with the figures per
+# start and, over the starts, the median and worst largest jump and how many starts jump more
+# than 0.5 m.
+#   --starts N   number of starts, 1 to 64 (default 8)
+#   --members M  matcher.sparse_ensemble_members for every start (default: configs/frontend.yaml's;
+#                1 measures a single frontend)
+set -euo pipefail
+# shellcheck source=scripts/eval-common.sh
+source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
+
+usage() {
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
+  exit "${1:-2}"
+}
+
+what="" starts=8 members=""
+while (($#)); do
+  case "$1" in
+    --starts) starts="${2:?--starts needs a number}"; shift 2 ;;
+    --members) members="${2:?--members needs a number}"; shift 2 ;;
+    -h | --help) usage 0 ;;
+    -*) echo "unknown option $1" >&2; usage ;;
+    *) [[ -z $what ]] || usage; what="$1"; shift ;;
+  esac
+done
+[[ -n $what ]] || usage
+[[ $starts =~ ^[0-9]+$ ]] && ((starts >= 1 && starts <= 64)) || die "--starts must be 1 to 64"
+[[ -z $members || $members =~ ^[0-9]+$ ]] || die "--members must be a number"
+
+need_programs traverse-frontend traverse-evaluator
+# The conversion (cached) and the reference's own evaluation, as scripts/eval-carmen.sh does it.
+"$ROOT/scripts/eval-carmen.sh" "$what" >/dev/null
+name="$(basename "$what")"
+name="${name%.gz}"
+name="${name%.log}"
+name="${name%-corrected}"
+cache="$ROOT/out/cache/carmen-$name.lcmlog"
+[[ -s $cache ]] || die "no converted log $cache"
+grep -q '^initial_pose: ' "$ROOT/configs/frontend.yaml" ||
+  die "configs/frontend.yaml has no top-level 'initial_pose:' line to replace"
+grep -q '^  sparse_ensemble_members: ' "$ROOT/configs/frontend.yaml" ||
+  die "configs/frontend.yaml has no 'matcher: sparse_ensemble_members:' line to replace"
+
+out="$ROOT/out/sensitivity/carmen-$name${members:+-members$members}"
+rm -rf "$out"
+mkdir -p "$out"
+runs=""
+jumps=()
+for ((i = 0; i < starts; i++)); do
+  # Start i: fractional parts of i times irrational steps (an additive recurrence), scaled to
+  # [0, 0.1) m in x and y and [-1, 1) degree; start 0 is the identity.
+  read -r x y theta < <(awk -v i="$i" 'BEGIN {
+    f = i * 0.6180339887; g = i * 0.7548776662; h = i * 0.5698402910
+    printf "%.4f %.4f %.6f\n", 0.1 * (f - int(f)), 0.1 * (g - int(g)),
+           (i == 0 ? 0 : (2 * (h - int(h)) - 1) * 3.14159265358979 / 180) }')
+  dir="$out/start-$i"
+  mkdir -p "$dir"
+  sed -e "s|^initial_pose: .*|initial_pose: {x_m: $x, y_m: $y, theta_rad: $theta}|" \
+    -e "${members:+s|^  sparse_ensemble_members: .*|  sparse_ensemble_members: $members|}" \
+    "$ROOT/configs/frontend.yaml" >"$dir/frontend.yaml"
+  "$BIN/traverse-frontend" --config "$dir/frontend.yaml" --replay "$cache" \
+    --record "$dir/run.lcmlog" >"$dir/frontend.out" 2>&1 ||
+    die "traverse-frontend failed on start $i, see $dir/frontend.out"
+  evaluate "$dir/run.lcmlog" POSE_FRONTEND POSE_REFERENCE "$dir"
+  rm -f "$dir/run.lcmlog"
+  read -r jump rpe1 rpe10 < <(echo "$EVAL_JSON" | awk '{
+    for (k = 1; k <= NF; k++) v[$k] = $(k + 1)
+    gsub(/[,}]/, "", v["\"max_jump_m\":"]); gsub(/[,}]/, "", v["\"rpe_1m_m\":"]);
+    gsub(/[,}]/, "", v["\"rpe_10m_m\":"])
+    print v["\"max_jump_m\":"], v["\"rpe_1m_m\":"], v["\"rpe_10m_m\":"] }')
+  [[ $jump =~ ^[0-9.]+$ ]] || die "no max_jump_m in the evaluator's JSON of start $i"
+  printf 'start %2d: x %.4f m, y %.4f m, theta %+.6f rad: largest jump %.3f m, rpe over 1 m %.3f m, over 10 m %.3f m\n' \
+    "$i" "$x" "$y" "$theta" "$jump" "$rpe1" "$rpe10" >&2
+  jumps+=("$jump")
+  runs+="${runs:+, }{\"x_m\": $x, \"y_m\": $y, \"theta_rad\": $theta, \"max_jump_m\": $jump, \"rpe_1m_m\": $rpe1, \"rpe_10m_m\": $rpe10}"
+done
+
+read -r median worst over < <(printf '%s\n' "${jumps[@]}" | sort -g | awk '
+  { v[NR] = $1; if ($1 > 0.5) n++ }
+  END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%.6f %.6f %d\n", m, v[NR], n }')
+members_used="$(awk '$1 == "sparse_ensemble_members:" { print $2 }' "$out/start-0/frontend.yaml")"
+echo "frontend-sensitivity: $name, $starts starts, $members_used-member ensemble: largest jump median $median m, worst $worst m, $over starts over 0.5 m; outputs in $out" >&2
+echo "{\"carmen\": $(json_str "$name"), \"starts\": $starts, \"sparse_ensemble_members\": $members_used, \"max_jump_median_m\": $median, \"max_jump_worst_m\": $worst, \"starts_over_0_5_m\": $over, \"runs\": [$runs], \"out_dir\": $(json_str "$out")}"
