@@ -258,6 +258,10 @@ void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred, bool
   velocity_ = velocity;  // a prediction carries no new information about the motion
 }
 
+Pose2 Frontend::initial_pose() const {
+  return Pose2(config_.initial_pose.x_m, config_.initial_pose.y_m, config_.initial_pose.theta_rad);
+}
+
 bool Frontend::map_update_due(const Pose2& T_map_base) const {
   const Pose2 d = between(T_map_base_last_update_, T_map_base);
   return d.translation().norm() >= config_.map.update_distance_m ||
@@ -346,6 +350,9 @@ FrontendResult Frontend::process_own(const Scan& scan) {
     ++counters_.scans_predicted;
     if (initialised_) {
       take_prediction(result, predict(scan.utime_last, use_imu, sparse_scan), sparse_scan);
+    } else {  // nothing to predict from yet: where the trajectory starts
+      result.T_map_base = initial_pose();
+      result.T_map_base_predicted = result.T_map_base;
     }
     result.status = ScanStatus::kPredicted;
     return result;
@@ -355,8 +362,7 @@ FrontendResult Frontend::process_own(const Scan& scan) {
   if (!initialised_) {
     // The first scan's pose is given (initial_pose, the identity by default): exact by definition.
     deskew(points, utimes, scan.utime_last, use_imu);
-    result.T_map_base =
-        Pose2(config_.initial_pose.x_m, config_.initial_pose.y_m, config_.initial_pose.theta_rad);
+    result.T_map_base = initial_pose();
     result.covariance = Eigen::Matrix3d::Identity() * 1e-12;
     result.matched_points = static_cast<int>(points.size());
   } else {

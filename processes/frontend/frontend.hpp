@@ -120,6 +120,7 @@ class Frontend {
   std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& points) const;
   void update_motion(const Pose2& T_map_base, int64_t utime, bool sparse_scan);
   bool map_update_due(const Pose2& T_map_base) const;
+  Pose2 initial_pose() const;  // the config's initial_pose
   // Gives `result` the predicted pose and a covariance grown by the prior's from the last one.
   void take_prediction(FrontendResult& result, const Pose2& T_pred, bool sparse_scan);
   // Whether a scan at `utime` is matched as a sparse scan (see the config's wide_search_gap_us);

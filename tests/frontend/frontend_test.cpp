@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -240,6 +241,28 @@ TEST(Frontend, ScanOfASparseLogStampedJustAfterTheLastIsStillMatchedAsSparse) {
   // interval alone, 4.4 m and 1.6 rad off from pose 9 on.
   EXPECT_LT(run.max_position_error_m, 0.05);
   EXPECT_LT(run.max_heading_error_rad, 0.01);
+}
+
+// A first scan too poor to match is flagged at the initial pose (there is nothing to predict
+// from); the first good scan then starts the map there.
+TEST(Frontend, BlindFirstScanIsPlacedAtTheInitialPose) {
+  FrontendConfig config;
+  config.initial_pose = {1.5, -0.25, 0.3};
+  Frontend frontend(config);
+  std::mt19937 rng(9);
+  const auto world = synthetic::room();
+  const auto still = [](int64_t) { return Pose2(0.2, 0.1, 0.0); };
+  Scan blind = synthetic::make_sweep(world, still, Pose2(), small_sweep(0), &rng);
+  std::fill(blind.ranges.begin(), blind.ranges.end(), std::numeric_limits<float>::quiet_NaN());
+  const Pose2 start(1.5, -0.25, 0.3);
+  for (int k = 0; k < 3; ++k) {
+    const FrontendResult r = k == 0 ? frontend.process(blind)
+                                    : frontend.process(synthetic::make_sweep(
+                                          world, still, Pose2(), small_sweep(k * kPeriodUs), &rng));
+    ASSERT_EQ(r.status, k == 0 ? ScanStatus::kPredicted : ScanStatus::kMatched) << k;
+    EXPECT_LT((r.T_map_base.translation() - start.translation()).norm(), 0.002) << k;
+    EXPECT_LT(std::abs(wrap_angle(r.T_map_base.theta() - start.theta())), 0.001) << k;
+  }
 }
 
 class FrontendBadScans : public ::testing::Test {
