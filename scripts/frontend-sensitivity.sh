@@ -41,14 +41,11 @@ done
 [[ -z $members || $members =~ ^[0-9]+$ ]] || die "--members must be a number"
 
 need_programs traverse-frontend traverse-evaluator
-# The conversion (cached) and the reference's own evaluation, as scripts/eval-carmen.sh does it.
-"$ROOT/scripts/eval-carmen.sh" "$what" >/dev/null
-name="$(basename "$what")"
-name="${name%.gz}"
-name="${name%.log}"
-name="${name%-corrected}"
-cache="$ROOT/out/cache/carmen-$name.lcmlog"
-[[ -s $cache ]] || die "no converted log $cache"
+# The log converted (cached) by scripts/eval-carmen.sh, whose JSON names it and the log's name.
+converted="$("$ROOT/scripts/eval-carmen.sh" "$what" | tail -n 1)"
+name="$(sed -n 's/.*"carmen": "\([^"]*\)".*/\1/p' <<<"$converted")"
+cache="$(sed -n 's/.*"lcm_log": "\([^"]*\)".*/\1/p' <<<"$converted")"
+[[ -n $name && -s $cache ]] || die "scripts/eval-carmen.sh $what named no converted log"
 grep -q '^initial_pose: ' "$ROOT/configs/frontend.yaml" ||
   die "configs/frontend.yaml has no top-level 'initial_pose:' line to replace"
 grep -q '^  sparse_ensemble_members: ' "$ROOT/configs/frontend.yaml" ||
