@@ -78,6 +78,9 @@ Frontend::Frontend(const FrontendConfig& config)
       map_(config.map),
       yaw_(rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
                         config.deskew.imu_yaw_rad)) {
+  // Before the first scan the last pose is where the trajectory starts.
+  T_map_base_last_ = initial_pose();
+  T_published_last_ = T_map_base_last_;
   if (config.matcher.sparse_ensemble_members <= 1) return;
   // The members' grids are offset by fractions of a cell of the wide search's level.
   const double cell_m = config.map.resolution_m * std::pow(2.0, std::min(1, config.map.levels - 1));
@@ -269,36 +272,32 @@ bool Frontend::map_update_due(const Pose2& T_map_base) const {
 }
 
 FrontendResult Frontend::process(const Scan& scan) {
+  if (config_.matcher.sparse_ensemble_members <= 1) return process_own(scan);
+  // Each frontend's last pose before this scan: its step is from there.
+  std::vector<Pose2> last{T_map_base_last_};
+  for (const auto& m : members_) last.push_back(m->T_map_base_last_);
   FrontendResult result = process_own(scan);
-  if (config_.matcher.sparse_ensemble_members <= 1) return result;
   std::vector<FrontendResult> member_results;
   member_results.reserve(members_.size());
   for (auto& m : members_) member_results.push_back(m->process(scan));
   if (result.status == ScanStatus::kDropped) return result;
-  vote(result, member_results);
+  vote(result, member_results, last);
   dense_in_a_row_ = result.sparse ? 0 : dense_in_a_row_ + 1;
-  if (dense_in_a_row_ >= kDenseScansEndingEnsemble && !members_.empty()) {
-    members_.clear();
-    own_last_.resize(1);
-  }
+  if (dense_in_a_row_ >= kDenseScansEndingEnsemble) members_.clear();
   return result;
 }
 
-void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& member_results) {
-  // own_last_[0] is this frontend's last own pose, own_last_[k] member k's; a member without a
-  // pose for this scan does not vote.
+void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& member_results,
+                    const std::vector<Pose2>& last) {
+  // results[0] is this frontend's own, results[k] member k's; a member without a pose for this
+  // scan does not vote. On the first scan every step is zero (each starts where it was put).
   std::vector<const FrontendResult*> results{&result};
   for (const FrontendResult& r : member_results) results.push_back(&r);
-  if (own_last_.empty()) {  // the first pose: the initial pose, published as it is
-    for (const FrontendResult* r : results) own_last_.push_back(r->T_map_base);
-    T_published_last_ = result.T_map_base;
-    return;
-  }
   std::vector<Pose2> steps;
   std::vector<std::size_t> voters;
-  for (std::size_t k = 0; k < results.size() && k < own_last_.size(); ++k) {
+  for (std::size_t k = 0; k < results.size(); ++k) {
     if (results[k]->status == ScanStatus::kDropped) continue;
-    steps.push_back(between(own_last_[k], results[k]->T_map_base));
+    steps.push_back(between(last[k], results[k]->T_map_base));
     voters.push_back(k);
   }
   const StepVote v = vote_on_steps(steps, T_published_last_.rotation());
@@ -312,13 +311,10 @@ void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& m
   J.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(turn).toRotationMatrix();
   const Eigen::Matrix3d covariance = J * c.covariance * J.transpose() + v.spread;
   const Pose2 predicted =
-      T_published_last_ * between(own_last_[voters[v.chosen]], c.T_map_base_predicted);
+      T_published_last_ * between(last[voters[v.chosen]], c.T_map_base_predicted);
 
   if (v.support < static_cast<int>(steps.size())) ++counters_.steps_disputed;
   if (!agrees(steps[0], step)) ++counters_.steps_outvoted;
-  for (std::size_t i = 0; i < voters.size(); ++i) {
-    own_last_[voters[i]] = results[voters[i]]->T_map_base;
-  }
   result.T_map_base = published;
   result.T_map_base_predicted = predicted;
   result.covariance = covariance;
@@ -363,6 +359,7 @@ FrontendResult Frontend::process_own(const Scan& scan) {
     // The first scan's pose is given (initial_pose, the identity by default): exact by definition.
     deskew(points, utimes, scan.utime_last, use_imu);
     result.T_map_base = initial_pose();
+    result.T_map_base_predicted = result.T_map_base;
     result.covariance = Eigen::Matrix3d::Identity() * 1e-12;
     result.matched_points = static_cast<int>(points.size());
   } else {

@@ -107,9 +107,11 @@ class Frontend {
  private:
   // The pipeline of one frontend: its own pose in its own map.
   FrontendResult process_own(const Scan& scan);
-  // Votes on the step from the last pose among this frontend and the ensemble's members;
-  // `result` (this frontend's own) becomes the published pose.
-  void vote(FrontendResult& result, const std::vector<FrontendResult>& member_results);
+  // Votes on the step from the last pose (`last`: this frontend's, then each member's, before the
+  // scan) among this frontend and the ensemble's members; `result` (this frontend's own) becomes
+  // the published pose.
+  void vote(FrontendResult& result, const std::vector<FrontendResult>& member_results,
+            const std::vector<Pose2>& last);
   // Valid readings as points in the base frame with their times; counts invalid ones.
   void valid_points(const Scan& scan, std::vector<Eigen::Vector2d>& points_base,
                     std::vector<int64_t>& utimes);
@@ -148,11 +150,10 @@ class Frontend {
   std::array<int64_t, kRecentIntervals> recent_intervals_us_{};
   std::size_t interval_count_ = 0;
 
-  // Sparse-scan ensemble: the other members (each a frontend of one, its grid offset), and the
-  // last own pose of this frontend and of each member; the last published pose; how many scans
-  // in a row were not sparse (three drop the members: a scanner's stream).
+  // Sparse-scan ensemble: the other members (each a frontend of one, its grid offset); the last
+  // published pose; how many scans in a row were not sparse (three drop the members: a scanner's
+  // stream).
   std::vector<std::unique_ptr<Frontend>> members_;
-  std::vector<Pose2> own_last_;
   Pose2 T_published_last_;
   int dense_in_a_row_ = 0;
 
