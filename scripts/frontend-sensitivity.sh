@@ -12,8 +12,8 @@
 # sequence: the same N gives the same figures every time.
 # Outputs under out/sensitivity/carmen-NAME/ (one directory per start: config, recorded log,
 # evaluator outputs); prints one line per start and, last, one JSON object with the figures per
-# start and, over the starts, the median and worst largest jump and how many starts jump more
-# than 0.5 m.
+# start and, over the starts, the median and worst largest jump, how many starts jump more than
+# 0.5 m, and the worst relative pose error over 10 m (a start that lost track).
 #   --starts N   number of starts, 1 to 64 (default 8)
 #   --members M  matcher.sparse_ensemble_members for every start (default: configs/frontend.yaml's;
 #                1 measures a single frontend)
@@ -55,7 +55,7 @@ out="$ROOT/out/sensitivity/carmen-$name${members:+-members$members}"
 rm -rf "$out"
 mkdir -p "$out"
 runs=""
-jumps=()
+jumps=() rpe10s=()
 for ((i = 0; i < starts; i++)); do
   # Start i: fractional parts of i times irrational steps (an additive recurrence), scaled to
   # [0, 0.1) m in x and y and [-1, 1) degree; start 0 is the identity.
@@ -82,12 +82,14 @@ for ((i = 0; i < starts; i++)); do
   printf 'start %2d: x %.4f m, y %.4f m, theta %+.6f rad: largest jump %.3f m, rpe over 1 m %.3f m, over 10 m %.3f m\n' \
     "$i" "$x" "$y" "$theta" "$jump" "$rpe1" "$rpe10" >&2
   jumps+=("$jump")
+  rpe10s+=("$rpe10")
   runs+="${runs:+, }{\"x_m\": $x, \"y_m\": $y, \"theta_rad\": $theta, \"max_jump_m\": $jump, \"rpe_1m_m\": $rpe1, \"rpe_10m_m\": $rpe10}"
 done
 
 read -r median worst over < <(printf '%s\n' "${jumps[@]}" | sort -g | awk '
   { v[NR] = $1; if ($1 > 0.5) n++ }
   END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%.6f %.6f %d\n", m, v[NR], n }')
+rpe10_worst="$(printf '%s\n' "${rpe10s[@]}" | sort -g | tail -n 1)"
 members_used="$(awk '$1 == "sparse_ensemble_members:" { print $2 }' "$out/start-0/frontend.yaml")"
-echo "frontend-sensitivity: $name, $starts starts, $members_used-member ensemble: largest jump median $median m, worst $worst m, $over starts over 0.5 m; outputs in $out" >&2
-echo "{\"carmen\": $(json_str "$name"), \"starts\": $starts, \"sparse_ensemble_members\": $members_used, \"max_jump_median_m\": $median, \"max_jump_worst_m\": $worst, \"starts_over_0_5_m\": $over, \"runs\": [$runs], \"out_dir\": $(json_str "$out")}"
+echo "frontend-sensitivity: $name, $starts starts, $members_used-member ensemble: largest jump median $median m, worst $worst m, $over starts over 0.5 m; rpe over 10 m worst $rpe10_worst m; outputs in $out" >&2
+echo "{\"carmen\": $(json_str "$name"), \"starts\": $starts, \"sparse_ensemble_members\": $members_used, \"max_jump_median_m\": $median, \"max_jump_worst_m\": $worst, \"starts_over_0_5_m\": $over, \"rpe_10m_worst_m\": $rpe10_worst, \"runs\": [$runs], \"out_dir\": $(json_str "$out")}"
