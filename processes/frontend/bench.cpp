@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
   std::printf("real-time factor at %.1f Hz on one core: %.1fx (scan period / mean time)\n",
               t.rate_hz, rtf);
   std::printf("map: %zu bytes after %lld updates; %lld scans needed the recovery search\n",
-              frontend.map().memory_bytes(), static_cast<long long>(c.map_updates),
+              frontend.map_memory_bytes(), static_cast<long long>(c.map_updates),
               static_cast<long long>(c.scans_searched));
   if (t.error_m >= 0.0) {
     std::printf("position error: %.4f m (%s)\n", t.error_m,
@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
       "\"per_scan_max_ms\": %.3f, \"scanner_rate_hz\": %.2f, \"real_time_factor\": %.2f, "
       "\"map_bytes\": %zu, \"map_updates\": %lld, \"position_error_m\": %.5f}\n",
       log_path.empty() ? "synthetic" : "log", t.ms.size(), t.points, t.matched_points, median, p99,
-      mean, sorted.back(), t.rate_hz, rtf, frontend.map().memory_bytes(),
+      mean, sorted.back(), t.rate_hz, rtf, frontend.map_memory_bytes(),
       static_cast<long long>(c.map_updates), t.error_m);
   return 0;
 }

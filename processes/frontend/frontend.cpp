@@ -261,6 +261,12 @@ void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred, bool
   velocity_ = velocity;  // a prediction carries no new information about the motion
 }
 
+std::size_t Frontend::map_memory_bytes() const {
+  std::size_t bytes = map_.memory_bytes();
+  for (const auto& m : members_) bytes += m->map_memory_bytes();
+  return bytes;
+}
+
 Pose2 Frontend::initial_pose() const {
   return Pose2(config_.initial_pose.x_m, config_.initial_pose.y_m, config_.initial_pose.theta_rad);
 }

@@ -102,6 +102,8 @@ class Frontend {
 
   const FrontendCounters& counters() const { return counters_; }
   const MapPyramid& map() const { return map_; }
+  // Bytes held by this frontend's map and, while a sparse-scan ensemble runs, its members' maps.
+  std::size_t map_memory_bytes() const;
   const FrontendConfig& config() const { return config_; }
 
  private:

@@ -13,13 +13,15 @@ namespace traverse::frontend {
 
 // Occupancy grid pyramid (Hector SLAM section IV.A, map update section IV.C).
 struct MapConfig {
-  double resolution_m = 0.05;       // finest level; level k has resolution_m * 2^k
-  int levels = 3;                   // pyramid depth, 1 = a single grid
-  double p_occupied = 0.9;          // probability an end point's cell is occupied (Hector 0.9)
-  double p_free = 0.4;              // probability a traversed cell is occupied (Hector 0.4)
-  double update_distance_m = 0.2;   // update the map when the pose moved this far ...
-  double update_angle_rad = 0.1;    // ... or turned this much since the last update
-  int64_t max_bytes = 512LL << 20;  // beyond this, tiles farthest from the pose are dropped
+  double resolution_m = 0.05;      // finest level; level k has resolution_m * 2^k
+  int levels = 3;                  // pyramid depth, 1 = a single grid
+  double p_occupied = 0.9;         // probability an end point's cell is occupied (Hector 0.9)
+  double p_free = 0.4;             // probability a traversed cell is occupied (Hector 0.4)
+  double update_distance_m = 0.2;  // update the map when the pose moved this far ...
+  double update_angle_rad = 0.1;   // ... or turned this much since the last update
+  // Beyond this, tiles farthest from the pose are dropped: per map, so a sparse-scan ensemble
+  // (MatcherConfig::sparse_ensemble_members) holds up to that many times this.
+  int64_t max_bytes = 512LL << 20;
 
   template <class V>
   void visit(V& v) {

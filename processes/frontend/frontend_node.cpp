@@ -64,7 +64,7 @@ void FrontendNode::report_counters() {
   counters_("readings_invalid", static_cast<double>(c.readings_invalid));
   counters_("map_updates", static_cast<double>(c.map_updates));
   counters_("map_tiles_evicted", static_cast<double>(c.map_tiles_evicted));
-  counters_("map_bytes", static_cast<double>(frontend_.map().memory_bytes()));
+  counters_("map_bytes", static_cast<double>(frontend_.map_memory_bytes()));
   counters_("imu_samples", static_cast<double>(c.imu_samples));
   counters_("imu_dropped", static_cast<double>(c.imu_dropped_time));
   counters_("steps_disputed", static_cast<double>(c.steps_disputed));

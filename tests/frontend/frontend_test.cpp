@@ -152,6 +152,8 @@ struct SparseRun {
   double max_position_error_m = 0.0, max_heading_error_rad = 0.0;
   int matched = 0;
   int min_voting = 1 << 20;  // fewest ensemble members voting on a step (after the first scan)
+  // Map memory the frontend reports over its own map's: the members' maps count too.
+  double map_bytes_over_own = 0.0;
 };
 // Pose k of a sparse log in the room (scans 3 s apart).
 Pose2 sparse_truth(int k) {
@@ -192,6 +194,8 @@ SparseRun run_sparse(const FrontendConfig& config, const std::vector<int64_t>& t
         std::max(run.max_heading_error_rad,
                  std::abs(wrap_angle(r.T_map_base.theta() - T_map_base_true.theta())));
   }
+  run.map_bytes_over_own = static_cast<double>(frontend.map_memory_bytes()) /
+                           static_cast<double>(frontend.map().memory_bytes());
   return run;
 }
 
@@ -212,6 +216,8 @@ TEST(Frontend, TracksSparseScansWithLargeTurns) {
   const SparseRun run = run_sparse(config);
   EXPECT_EQ(run.matched, 18);
   EXPECT_EQ(run.min_voting, config.matcher.sparse_ensemble_members);
+  std::printf("map memory reported: %.2f times the own map's\n", run.map_bytes_over_own);
+  EXPECT_GT(run.map_bytes_over_own, config.matcher.sparse_ensemble_members - 0.5);
   EXPECT_LT(run.max_position_error_m, 0.05);
   EXPECT_LT(run.max_heading_error_rad, 0.01);
   // The same scans with the wide search switched off (gap threshold beyond the scans' 3 s): the
