@@ -240,12 +240,14 @@ bool Frontend::sparse(int64_t utime) const {
   // This scan comes long after the last, or the stream's recent scans did: a log subsampled by
   // travel, whose timestamps also hold repeats and near repeats (intel: 23 of 910 scans under
   // 0.5 s apart, some 0 s) that say nothing about the motion in between.
-  const int64_t gap = config_.matcher.wide_search_gap_us;
-  if (utime - last_utime_ > gap) return true;
+  return utime - last_utime_ > config_.matcher.wide_search_gap_us || subsampled_by_travel();
+}
+
+bool Frontend::subsampled_by_travel() const {
   if (interval_count_ < kRecentIntervals) return false;
   std::array<int64_t, kRecentIntervals> sorted = recent_intervals_us_;
   std::nth_element(sorted.begin(), sorted.begin() + kRecentIntervals / 2, sorted.end());
-  return sorted[kRecentIntervals / 2] > gap;
+  return sorted[kRecentIntervals / 2] > config_.matcher.wide_search_gap_us;
 }
 
 void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred, bool sparse_scan) {
@@ -378,9 +380,12 @@ FrontendResult Frontend::process_own(const Scan& scan) {
         std::abs(between(T_pred, T_map_base_last_).theta()) > 0.01) {
       other_centres.push_back(T_map_base_last_);
     }
+    // The step prior holds for a log subsampled by travel, not for a pause in a scanner's stream
+    // (freiburg-079: 40 gaps over 0.5 s, the robot standing still).
     const MatchResult m =
         sparse_scan
-            ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher)
+            ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher,
+                              subsampled_by_travel() ? &T_map_base_last_ : nullptr)
             : match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
     // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes

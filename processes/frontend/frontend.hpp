@@ -8,7 +8,8 @@
 //      last point with the heading change at its own time (IMU yaw rate, or the constant
 //      angular velocity without IMU) and, optionally, the constant-velocity translation;
 //   4. match the points against the map pyramid, coarse to fine, from the prediction (sparse
-//      scans: from the best pose of a wide correlative search around it);
+//      scans: from the best pose of a wide correlative search around it, which on a log
+//      subsampled by travel also weighs the step's shape: MatcherConfig::sparse_step_*);
 //   5. update the map when the pose moved or turned past a threshold since the last update.
 // Sparse scans go through this pipeline in several frontends at once (an ensemble, see
 // MatcherConfig::sparse_ensemble_members), each with its own map on a grid offset by a fraction
@@ -130,6 +131,9 @@ class Frontend {
   // Whether a scan at `utime` is matched as a sparse scan (see the config's wide_search_gap_us);
   // decided once per scan, before the motion state changes.
   bool sparse(int64_t utime) const;
+  // Whether the stream's recent scans came further apart than wide_search_gap_us (their median):
+  // a log subsampled by travel, not a pause in a scanner's stream.
+  bool subsampled_by_travel() const;
 
   FrontendConfig config_;
   Pose2 T_base_laser_;

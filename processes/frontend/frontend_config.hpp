@@ -90,13 +90,33 @@ struct MatcherConfig {
   // is offset from the others' by a fraction of a cell and turned by under a degree; each scan's
   // published step is the one most of them agree on (within 0.15 m and 0.05 rad), and the spread
   // of their steps is added to its covariance. On a sparse log the outcome of one frontend turns
-  // on such offsets: on CARMEN aces, from 8 offsets, one frontend jumps 0.54 to 2.6 m and 5 times
-  // loses track (RPE over 10 m 1.9 to 2.7 m); the members mostly go wrong at different scans, and
-  // five of them jump 0.23 to 1.56 m with RPE over 10 m at most 0.47 m
+  // on such offsets: on CARMEN aces, from 8 offsets, one frontend jumps 0.67 to 2.3 m and 3 times
+  // loses track (RPE over 10 m 1.5 to 1.9 m); the members mostly go wrong at different scans, and
+  // five of them jump 0.19 to 0.92 m (7 of 8 under 0.5 m) with RPE over 10 m at most 0.27 m
   // (scripts/frontend-sensitivity.sh aces, --members 1). Steps most members misjudge together
-  // remain. Costs this many times the sparse path's time; a scanner's stream (three scans in a
-  // row that are not sparse) drops the extra members. 1 runs one frontend.
+  // remain (intel scan 761, 0.87 m). Costs this many times the sparse path's time; a scanner's
+  // stream (three scans in a row that are not sparse) drops the extra members. 1 runs one frontend.
   int sparse_ensemble_members = 5;
+  // Prior on the shape of a sparse scan's step (wide_search.hpp, StepPrior), from this frontend's
+  // last pose: a log subsampled by travel rarely steps both under sparse_step_min_travel_m and
+  // under sparse_step_min_turn_rad (the CARMEN sets keep a scan after about 1 m or 0.5 rad; 45 of
+  // intel's 909 and 23 of aces' 439 reference steps are under 0.8 m and 0.4 rad), and a wheeled
+  // platform's step lies on the arc through its turn (1 of intel's, 2 of aces' and 5 of csail's 405
+  // reference steps are more than 0.3 m sideways off it or backwards). Each term costs up to its
+  // weight per point, against evidence of 2 per point between an occupied and a free cell. It is
+  // what keeps a frontend from stalling where the scan fits the last pose as well as the next
+  // (along a corridor) or sliding sideways: on aces the largest jump falls from 1.03 to 0.22 m and
+  // the RPE over 10 m from 0.47 to 0.15 m (scripts/eval-carmen.sh aces --stages frontend, both
+  // weights 0 and as shipped). It holds only for a log subsampled by travel (the median of the last
+  // five intervals above wide_search_gap_us), not for a pause in a scanner's stream, where the
+  // platform stood still.
+  // A weight of 0 leaves its term out; a platform that may step sideways or backwards between
+  // sparse scans (a hand-held scanner) needs sparse_step_off_arc_weight 0.
+  double sparse_step_min_travel_m = 0.8;
+  double sparse_step_min_turn_rad = 0.4;
+  double sparse_step_short_weight = 0.2;
+  double sparse_step_off_arc_free_m = 0.2;
+  double sparse_step_off_arc_weight = 0.1;
 
   template <class V>
   void visit(V& v) {
@@ -119,6 +139,11 @@ struct MatcherConfig {
     v("wide_search_angular_window_rad", wide_search_angular_window_rad);
     v("wide_search_temperature", wide_search_temperature);
     v("sparse_ensemble_members", sparse_ensemble_members);
+    v("sparse_step_min_travel_m", sparse_step_min_travel_m);
+    v("sparse_step_min_turn_rad", sparse_step_min_turn_rad);
+    v("sparse_step_short_weight", sparse_step_short_weight);
+    v("sparse_step_off_arc_free_m", sparse_step_off_arc_free_m);
+    v("sparse_step_off_arc_weight", sparse_step_off_arc_weight);
   }
 };
 
@@ -216,6 +241,12 @@ inline std::optional<std::string> config_problem(const FrontendConfig& c) {
     return "matcher.sparse_ensemble_members must be 1 to 16";
   if (!(c.matcher.wide_search_temperature >= 0.0))
     return "matcher.wide_search_temperature must not be negative";
+  if (!(c.matcher.sparse_step_min_travel_m > 0.0 && c.matcher.sparse_step_min_turn_rad > 0.0))
+    return "matcher.sparse_step_min_travel_m and sparse_step_min_turn_rad must be positive";
+  if (!(c.matcher.sparse_step_short_weight >= 0.0 && c.matcher.sparse_step_off_arc_weight >= 0.0 &&
+        c.matcher.sparse_step_off_arc_free_m >= 0.0))
+    return "matcher.sparse_step_short_weight, sparse_step_off_arc_weight and "
+           "sparse_step_off_arc_free_m must not be negative";
   return std::nullopt;
 }
 

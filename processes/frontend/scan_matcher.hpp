@@ -75,9 +75,11 @@ Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>&
 
 // Wide search around priors[0] (not empty) on pyramid level min(1, levels - 1) with a motion
 // prior towards the nearest of `priors`, then Gauss-Newton over all levels from the best pose,
-// with the Gauss-Newton prior centred on it.
+// with the Gauss-Newton prior centred on it. With T_last (the pose the step starts from), the
+// search also weighs the step's shape (StepPrior, config's sparse_step_* keys).
 MatchResult match_scan_wide(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
-                            const std::vector<Pose2>& priors, const MatcherConfig& config);
+                            const std::vector<Pose2>& priors, const MatcherConfig& config,
+                            const Pose2* T_last = nullptr);
 
 // A match with a poor fit (residual above config.search_trigger_residual) that ends farther from
 // the prediction than config.search_max_unverified_m or _rad: nothing confirms such a jump.

@@ -11,12 +11,16 @@ constexpr double kMotionWeight = 0.05;
 // Poses scoring more than this many temperatures below the best weigh under exp(-8) = 3e-4 in the
 // score surface's spread, and are left out of it.
 constexpr double kSurfaceMargin = 8.0;
+// A step off its arc (sideways or backwards) by StepPrior::off_arc_free_m plus this loses
+// StepPrior::off_arc_weight per point, quadratically.
+constexpr double kOffArcScaleM = 0.3;
 }  // namespace
 
 WideSearchResult wide_search(const OccupancyGrid& grid,
                              const std::vector<Eigen::Vector2d>& points_base, const Pose2& T_center,
                              double linear_window_m, double angular_window_rad,
-                             const std::vector<Pose2>& priors, double temperature) {
+                             const std::vector<Pose2>& priors, double temperature,
+                             const StepPrior* step_prior) {
   // Block side of the coarse level of the branch and bound [cells]: a coarse candidate stands for
   // kBlock x kBlock translations, bounded by the maximum of the table over that block.
   constexpr int kBlock = 4;
@@ -123,6 +127,42 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
     const double d = h < lo ? lo - h : (h > lo + size - 1 ? h - (lo + size - 1) : 0.0);
     return d * d;
   };
+  // Step prior (StepPrior): per point, the smallest over a block of translations (a valid bound):
+  // the step's length is largest at a corner, and its forward and sideways parts, linear in the
+  // translation for one heading, are extreme at corners.
+  const bool use_step =
+      step_prior != nullptr && step_prior->min_travel_m > 0.0 && step_prior->min_turn_rad > 0.0;
+  const Eigen::Vector2d last_cells =
+      use_step ? Eigen::Vector2d((step_prior->T_last.translation() - T_center.translation()) / res)
+               : Eigen::Vector2d::Zero();
+  const auto step_cost = [&](int a, int dx, int dy, int size) {
+    if (!use_step) return 0.0;
+    const StepPrior& sp = *step_prior;
+    const double turn =
+        wrap_angle(T_center.theta() + (a - n_angles) * angle_step - sp.T_last.theta());
+    // The chord of an arc turning by `turn` points half as far round: sideways = forward * tan.
+    const double tan_half = std::tan(std::clamp(0.5 * turn, -M_PI / 4.0, M_PI / 4.0));
+    const Eigen::Matrix2d R_last_map = sp.T_last.rotation().transpose();
+    double length = 0.0, forward = -std::numeric_limits<double>::infinity();
+    double side_lo = std::numeric_limits<double>::infinity(), side_hi = -side_lo;
+    for (const int cx : {dx, dx + size - 1}) {
+      for (const int cy : {dy, dy + size - 1}) {
+        const Eigen::Vector2d v = R_last_map * (res * (Eigen::Vector2d(cx, cy) - last_cells));
+        length = std::max(length, v.norm());
+        forward = std::max(forward, v.x());
+        side_lo = std::min(side_lo, v.y() - v.x() * tan_half);
+        side_hi = std::max(side_hi, v.y() - v.x() * tan_half);
+      }
+    }
+    double cost = 0.0;
+    const double inside =
+        1.0 - std::max(length / sp.min_travel_m, std::abs(turn) / sp.min_turn_rad);
+    if (inside > 0.0) cost += sp.short_weight * inside * inside;
+    const double side = side_lo > 0.0 ? side_lo : (side_hi < 0.0 ? -side_hi : 0.0);
+    const double e_side = std::max(0.0, side - sp.off_arc_free_m) / kOffArcScaleM;
+    const double e_back = std::max(0.0, -forward - sp.off_arc_free_m) / kOffArcScaleM;
+    return cost + sp.off_arc_weight * (e_side * e_side + e_back * e_back);
+  };
   const auto penalty = [&](int a, int dx, int dy, int size) {
     const double theta = (a - n_angles) * angle_step;
     double best_h = std::numeric_limits<double>::infinity();
@@ -132,7 +172,7 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
           best_h,
           (gap_sq(dx, size, o.x) + gap_sq(dy, size, o.y)) / (cells_sigma * cells_sigma) + da * da);
     }
-    return static_cast<float>(n_points * w_motion * best_h);
+    return static_cast<float>(n_points * (w_motion * best_h + step_cost(a, dx, dy, size)));
   };
 
   // Level 1: every angle and every block of translations, scored by its bound.

@@ -116,6 +116,54 @@ TEST(ScanMatcher, WideSearchSpreadGrowsAlongCorridorAxis) {
   EXPECT_LT(std::sqrt(m.covariance(1, 1)), 0.03);
 }
 
+// The step prior (StepPrior) decides what a featureless corridor leaves open. The scan, taken
+// 1 m along the axis, fits every pose along it alike; predicted at the last pose (a stall), the
+// motion prior alone keeps the pose there, while with the step prior the step goes forward by
+// most of the travel a log subsampled by travel needs, and stays on the axis. In a room, where
+// the scan decides, a real short step stands.
+TEST(ScanMatcher, StepPriorMovesStalledStepForwardOnlyWhereScanCannotTell) {
+  std::vector<Pose2> walk;
+  const auto corridor = synthetic::corridor(200.0, 2.4);
+  for (double x = -20.0; x <= 20.0; x += 0.37) walk.emplace_back(x, 0.0, 0.0);
+  const MapPyramid corridor_map = build_map(corridor, walk);
+  std::vector<Eigen::Vector2d> points;
+  for (const auto& p : static_scan(corridor, Pose2(1.0, 0.1, 0.0), 360, 0.005, 1, 15.0)) {
+    if (p.x() > 0.0) points.push_back(p);
+  }
+  const Pose2 last(0.0, 0.1, 0.0);
+  const StepPrior prior{last, 0.8, 0.4, 0.2, 0.2, 0.1};
+  const WideSearchResult plain = wide_search(corridor_map.level(1), points, last, 2.0, 1.5, {last});
+  const WideSearchResult with_prior =
+      wide_search(corridor_map.level(1), points, last, 2.0, 1.5, {last}, 0.0, &prior);
+  std::printf("stalled prediction: without the step prior x %.2f m, with it x %.2f y %.2f m\n",
+              plain.T_map_base.x(), with_prior.T_map_base.x(), with_prior.T_map_base.y());
+  EXPECT_NEAR(plain.T_map_base.x(), last.x(), 0.15);
+  // Forward, not backward: the two are alike but for the off-arc term.
+  EXPECT_GT(with_prior.T_map_base.x() - last.x(), 0.4);
+  EXPECT_LT(with_prior.T_map_base.x() - last.x(), 1.0);
+  EXPECT_NEAR(with_prior.T_map_base.y(), last.y(), 0.1);
+  EXPECT_LT(std::abs(with_prior.T_map_base.theta()), 0.05);
+  // The short-step term alone moves the pose as far, but backwards as readily as forwards.
+  const StepPrior short_only{last, 0.8, 0.4, 0.2, 0.2, 0.0};
+  const WideSearchResult short_alone =
+      wide_search(corridor_map.level(1), points, last, 2.0, 1.5, {last}, 0.0, &short_only);
+  EXPECT_GT(std::abs(short_alone.T_map_base.x() - last.x()), 0.4);
+
+  const auto room = synthetic::room();
+  const MapPyramid room_map = build_map(room, {kMapPose, Pose2(-1.5, 1.0, 0.0)});
+  const Pose2 room_last(0.4, 0.4, 0.3);
+  const Pose2 truth = room_last * Pose2(0.1, 0.0, 0.05);  // 0.1 m and 3 degrees: a stall's size
+  std::vector<Eigen::Vector2d> room_points;
+  for (const auto& p : static_scan(room, truth, 360, 0.005)) {
+    if (p.x() > 0.0) room_points.push_back(p);
+  }
+  const StepPrior room_prior{room_last, 0.8, 0.4, 0.2, 0.2, 0.1};
+  const WideSearchResult in_room = wide_search(room_map.level(1), room_points, room_last, 2.0, 1.5,
+                                               {room_last}, 0.0, &room_prior);
+  EXPECT_LT((in_room.T_map_base.translation() - truth.translation()).norm(), 0.1);
+  EXPECT_LT(std::abs(wrap_angle(in_room.T_map_base.theta() - truth.theta())), 0.02);
+}
+
 // The whole pyramid, coarse to fine, converges from further away than any single fine level.
 TEST(ScanMatcher, PyramidConvergesFromLargeOffset) {
   const auto world = synthetic::room();
