@@ -135,14 +135,24 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
   const Eigen::Vector2d last_cells =
       use_step ? Eigen::Vector2d((step_prior->T_last.translation() - T_center.translation()) / res)
                : Eigen::Vector2d::Zero();
+  // Per angle: the step's turn and the tangent of half of it (the chord of an arc turning by
+  // `turn` points half as far round: sideways = forward * tan).
+  std::vector<double> step_turn, step_tan_half;
+  const Eigen::Matrix2d R_last_map =
+      use_step ? Eigen::Matrix2d(step_prior->T_last.rotation().transpose())
+               : Eigen::Matrix2d::Identity();
+  if (use_step) {
+    for (int a = 0; a < 2 * n_angles + 1; ++a) {
+      step_turn.push_back(
+          wrap_angle(T_center.theta() + (a - n_angles) * angle_step - step_prior->T_last.theta()));
+      step_tan_half.push_back(
+          std::tan(std::clamp(0.5 * step_turn.back(), -M_PI / 4.0, M_PI / 4.0)));
+    }
+  }
   const auto step_cost = [&](int a, int dx, int dy, int size) {
     if (!use_step) return 0.0;
     const StepPrior& sp = *step_prior;
-    const double turn =
-        wrap_angle(T_center.theta() + (a - n_angles) * angle_step - sp.T_last.theta());
-    // The chord of an arc turning by `turn` points half as far round: sideways = forward * tan.
-    const double tan_half = std::tan(std::clamp(0.5 * turn, -M_PI / 4.0, M_PI / 4.0));
-    const Eigen::Matrix2d R_last_map = sp.T_last.rotation().transpose();
+    const double turn = step_turn[a], tan_half = step_tan_half[a];
     double length = 0.0, forward = -std::numeric_limits<double>::infinity();
     double side_lo = std::numeric_limits<double>::infinity(), side_hi = -side_lo;
     for (const int cx : {dx, dx + size - 1}) {
