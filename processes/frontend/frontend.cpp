@@ -236,13 +236,6 @@ void Frontend::update_motion(const Pose2& T_map_base, int64_t utime, bool sparse
   last_utime_ = utime;
 }
 
-bool Frontend::sparse(int64_t utime) const {
-  // This scan comes long after the last, or the stream's recent scans did: a log subsampled by
-  // travel, whose timestamps also hold repeats and near repeats (intel: 23 of 910 scans under
-  // 0.5 s apart, some 0 s) that say nothing about the motion in between.
-  return utime - last_utime_ > config_.matcher.wide_search_gap_us || subsampled_by_travel();
-}
-
 bool Frontend::subsampled_by_travel() const {
   if (interval_count_ < kRecentIntervals) return false;
   std::array<int64_t, kRecentIntervals> sorted = recent_intervals_us_;
@@ -347,7 +340,14 @@ FrontendResult Frontend::process_own(const Scan& scan) {
   result.valid_points = static_cast<int>(points.size());
   const bool use_imu = imu_active(scan);
   result.imu_used = use_imu;
-  const bool sparse_scan = initialised_ && sparse(scan.utime_last);
+  // Sparse: this scan comes long after the last, or the stream's recent scans did (a log
+  // subsampled by travel, whose timestamps also hold repeats and near repeats that say nothing
+  // about the motion in between: intel has 23 of 910 scans under 0.5 s apart, some 0 s). Decided
+  // once per scan, before the motion state changes.
+  const bool by_travel = initialised_ && subsampled_by_travel();
+  const bool sparse_scan =
+      initialised_ &&
+      (scan.utime_last - last_utime_ > config_.matcher.wide_search_gap_us || by_travel);
   result.sparse = sparse_scan;
 
   if (static_cast<int>(points.size()) < config_.matcher.min_valid_points) {
@@ -385,7 +385,7 @@ FrontendResult Frontend::process_own(const Scan& scan) {
     const MatchResult m =
         sparse_scan
             ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher,
-                              subsampled_by_travel() ? &T_map_base_last_ : nullptr)
+                              by_travel ? &T_map_base_last_ : nullptr)
             : match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
     // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes

@@ -128,11 +128,9 @@ class Frontend {
   Pose2 initial_pose() const;  // the config's initial_pose
   // Gives `result` the predicted pose and a covariance grown by the prior's from the last one.
   void take_prediction(FrontendResult& result, const Pose2& T_pred, bool sparse_scan);
-  // Whether a scan at `utime` is matched as a sparse scan (see the config's wide_search_gap_us);
-  // decided once per scan, before the motion state changes.
-  bool sparse(int64_t utime) const;
   // Whether the stream's recent scans came further apart than wide_search_gap_us (their median):
-  // a log subsampled by travel, not a pause in a scanner's stream.
+  // a log subsampled by travel, not a pause in a scanner's stream. Such a stream's scans are all
+  // matched as sparse scans (see the config's wide_search_gap_us), with the step prior.
   bool subsampled_by_travel() const;
 
   FrontendConfig config_;

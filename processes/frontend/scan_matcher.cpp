@@ -272,23 +272,24 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
   return result;
 }
 
+StepPrior step_prior(const MatcherConfig& config, const Pose2& T_last) {
+  return {T_last,
+          config.sparse_step_min_travel_m,
+          config.sparse_step_min_turn_rad,
+          config.sparse_step_short_weight,
+          config.sparse_step_off_arc_free_m,
+          config.sparse_step_off_arc_weight};
+}
+
 MatchResult match_scan_wide(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
                             const std::vector<Pose2>& priors, const MatcherConfig& config,
                             const Pose2* T_last) {
   const int search_level = std::min(1, maps.levels() - 1);
-  StepPrior step_prior;
-  if (T_last) {
-    step_prior = {*T_last,
-                  config.sparse_step_min_travel_m,
-                  config.sparse_step_min_turn_rad,
-                  config.sparse_step_short_weight,
-                  config.sparse_step_off_arc_free_m,
-                  config.sparse_step_off_arc_weight};
-  }
+  const StepPrior prior = T_last ? step_prior(config, *T_last) : StepPrior{};
   const WideSearchResult s =
       wide_search(maps.level(search_level), points_base, priors.front(),
                   config.wide_search_linear_window_m, config.wide_search_angular_window_rad, priors,
-                  config.wide_search_temperature, T_last ? &step_prior : nullptr);
+                  config.wide_search_temperature, T_last ? &prior : nullptr);
   MatchResult result =
       refine(maps, points_base, s.T_map_base, s.T_map_base, config, maps.levels() - 1, 0);
   // The Gauss-Newton covariance is the curvature where it ended; the search's spread adds what

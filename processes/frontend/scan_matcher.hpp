@@ -73,6 +73,9 @@ NormalEquations normal_equations(const OccupancyGrid& grid,
 Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
                   const Pose2& T_center, double linear_window_m, double angular_window_rad);
 
+// The step prior of config's sparse_step_* keys for a step from T_last.
+StepPrior step_prior(const MatcherConfig& config, const Pose2& T_last);
+
 // Wide search around priors[0] (not empty) on pyramid level min(1, levels - 1) with a motion
 // prior towards the nearest of `priors`, then Gauss-Newton over all levels from the best pose,
 // with the Gauss-Newton prior centred on it. With T_last (the pose the step starts from), the

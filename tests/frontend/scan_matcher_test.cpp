@@ -131,7 +131,8 @@ TEST(ScanMatcher, StepPriorMovesStalledStepForwardOnlyWhereScanCannotTell) {
     if (p.x() > 0.0) points.push_back(p);
   }
   const Pose2 last(0.0, 0.1, 0.0);
-  const StepPrior prior{last, 0.8, 0.4, 0.2, 0.2, 0.1};
+  const MatcherConfig config;  // the shipped step prior: 0.8 m, 0.4 rad, weights 0.2 and 0.1
+  const StepPrior prior = step_prior(config, last);
   const WideSearchResult plain = wide_search(corridor_map.level(1), points, last, 2.0, 1.5, {last});
   const WideSearchResult with_prior =
       wide_search(corridor_map.level(1), points, last, 2.0, 1.5, {last}, 0.0, &prior);
@@ -144,7 +145,8 @@ TEST(ScanMatcher, StepPriorMovesStalledStepForwardOnlyWhereScanCannotTell) {
   EXPECT_NEAR(with_prior.T_map_base.y(), last.y(), 0.1);
   EXPECT_LT(std::abs(with_prior.T_map_base.theta()), 0.05);
   // The short-step term alone moves the pose as far, but backwards as readily as forwards.
-  const StepPrior short_only{last, 0.8, 0.4, 0.2, 0.2, 0.0};
+  StepPrior short_only = prior;
+  short_only.off_arc_weight = 0.0;
   const WideSearchResult short_alone =
       wide_search(corridor_map.level(1), points, last, 2.0, 1.5, {last}, 0.0, &short_only);
   EXPECT_GT(std::abs(short_alone.T_map_base.x() - last.x()), 0.4);
@@ -157,7 +159,7 @@ TEST(ScanMatcher, StepPriorMovesStalledStepForwardOnlyWhereScanCannotTell) {
   for (const auto& p : static_scan(room, truth, 360, 0.005)) {
     if (p.x() > 0.0) room_points.push_back(p);
   }
-  const StepPrior room_prior{room_last, 0.8, 0.4, 0.2, 0.2, 0.1};
+  const StepPrior room_prior = step_prior(config, room_last);
   const WideSearchResult in_room = wide_search(room_map.level(1), room_points, room_last, 2.0, 1.5,
                                                {room_last}, 0.0, &room_prior);
   EXPECT_LT((in_room.T_map_base.translation() - truth.translation()).norm(), 0.1);
