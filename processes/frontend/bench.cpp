@@ -57,7 +57,7 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
     timing.ms.push_back(cpu_ms() - t0);
     timing.points = static_cast<int>(scan.ranges.size());
     timing.matched_points = r.matched_points;
-    if (r.status != fe::ScanStatus::kDropped) estimates.emplace_back(r.utime, r.T_map_base);
+    if (r.has_pose()) estimates.emplace_back(r.utime, r.T_map_base);
   };
   while (auto ev = reader.next()) {
     if (ev->channel == traverse::channels::kImu) {
@@ -82,6 +82,7 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
     }
   }
   for (const auto& scan : pending) process(scan);
+  if (const auto r = frontend.finish()) estimates.emplace_back(r->utime, r->T_map_base);
   // Position error RMS against the simulator's ground truth (interpolated to each pose's time),
   // the estimate's map frame tied to the truth at the first pose.
   auto truth_at = [&](int64_t t) -> std::optional<traverse::Pose2> {

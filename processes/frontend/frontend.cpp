@@ -25,6 +25,10 @@ constexpr double kAgreeM = 0.15, kAgreeRad = 0.05;
 // This many scans in a row that are not sparse make a scanner's stream: the ensemble is dropped
 // (on the CARMEN logs every scan after the first is sparse; a stream pays for three scans).
 constexpr int kDenseScansEndingEnsemble = 3;
+// Sparse lag: a step longer than this many times the 90th percentile of the last settled steps
+// is long for the log; it loses sparse_lag_long_weight per point at this much beyond.
+constexpr double kLongStepFactor = 1.25;
+constexpr double kLongStepScaleM = 0.3;
 
 // Offset of ensemble member k (1, 2, ...) from the initial pose: fractions of a cell of
 // `cell_m` in x and y and up to a degree of heading, from an additive recurrence of irrational
@@ -81,6 +85,7 @@ Frontend::Frontend(const FrontendConfig& config)
   // Before the first scan the last pose is where the trajectory starts.
   T_map_base_last_ = initial_pose();
   T_published_last_ = T_map_base_last_;
+  T_emitted_last_ = T_map_base_last_;
   if (config.matcher.sparse_ensemble_members <= 1) return;
   // The members' grids are offset by fractions of a cell of the wide search's level.
   const double cell_m = config.map.resolution_m * std::pow(2.0, std::min(1, config.map.levels - 1));
@@ -274,14 +279,14 @@ bool Frontend::map_update_due(const Pose2& T_map_base) const {
 
 FrontendResult Frontend::process(const Scan& scan) {
   if (config_.matcher.sparse_ensemble_members <= 1) return process_own(scan);
-  // Each frontend's last pose before this scan: its step is from there.
-  std::vector<Pose2> last{T_map_base_last_};
-  for (const auto& m : members_) last.push_back(m->T_map_base_last_);
+  // The pose each frontend last gave: the step of its result is from there.
+  std::vector<Pose2> last{T_emitted_last_};
+  for (const auto& m : members_) last.push_back(m->T_emitted_last_);
   FrontendResult result = process_own(scan);
   std::vector<FrontendResult> member_results;
   member_results.reserve(members_.size());
   for (auto& m : members_) member_results.push_back(m->process(scan));
-  if (result.status == ScanStatus::kDropped) return result;
+  if (!result.has_pose()) return result;
   vote(result, member_results, last);
   dense_in_a_row_ = result.sparse ? 0 : dense_in_a_row_ + 1;
   if (dense_in_a_row_ >= kDenseScansEndingEnsemble) members_.clear();
@@ -297,7 +302,7 @@ void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& m
   std::vector<Pose2> steps;
   std::vector<std::size_t> voters;
   for (std::size_t k = 0; k < results.size(); ++k) {
-    if (results[k]->status == ScanStatus::kDropped) continue;
+    if (!results[k]->has_pose() || results[k]->utime != result.utime) continue;
     steps.push_back(between(last[k], results[k]->T_map_base));
     voters.push_back(k);
   }
@@ -324,7 +329,7 @@ void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& m
   T_published_last_ = published;
 }
 
-FrontendResult Frontend::process_own(const Scan& scan) {
+FrontendResult Frontend::measure(const Scan& scan, bool& by_travel_out) {
   ++counters_.scans_received;
   FrontendResult result;
   result.utime = scan.utime_last;
@@ -345,6 +350,7 @@ FrontendResult Frontend::process_own(const Scan& scan) {
   // about the motion in between: intel has 23 of 910 scans under 0.5 s apart, some 0 s). Decided
   // once per scan, before the motion state changes.
   const bool by_travel = initialised_ && subsampled_by_travel();
+  by_travel_out = by_travel;
   const bool sparse_scan =
       initialised_ &&
       (scan.utime_last - last_utime_ > config_.matcher.wide_search_gap_us || by_travel);
@@ -382,11 +388,12 @@ FrontendResult Frontend::process_own(const Scan& scan) {
     }
     // The step prior holds for a log subsampled by travel, not for a pause in a scanner's stream
     // (freiburg-079: 40 gaps over 0.5 s, the robot standing still).
+    matched_buffer_ = subsample(points);
     const MatchResult m =
         sparse_scan
-            ? match_scan_wide(map_, subsample(points), {T_pred}, config_.matcher,
+            ? match_scan_wide(map_, matched_buffer_, {T_pred}, config_.matcher,
                               by_travel ? &T_map_base_last_ : nullptr)
-            : match_scan(map_, subsample(points), T_pred, config_.matcher, -1, 0, other_centres);
+            : match_scan(map_, matched_buffer_, T_pred, config_.matcher, -1, 0, other_centres);
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
     // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes
     // from a scan that fits nowhere (people round the scanner, a view the map has not seen):
@@ -410,17 +417,164 @@ FrontendResult Frontend::process_own(const Scan& scan) {
   }
   ++counters_.scans_matched;
   covariance_last_ = result.covariance;
-
-  if (!initialised_ || map_update_due(result.T_map_base)) {
-    map_.update(result.T_map_base, T_base_laser_.translation(), points);
-    T_map_base_last_update_ = result.T_map_base;
-    counters_.map_tiles_evicted += static_cast<int64_t>(map_.bound_memory(
-        result.T_map_base.translation(), static_cast<std::size_t>(config_.map.max_bytes)));
-    ++counters_.map_updates;
-    result.map_updated = true;
-  }
   update_motion(result.T_map_base, scan.utime_last, sparse_scan);
   initialised_ = true;
+  return result;
+}
+
+void Frontend::add_to_map(FrontendResult& result, const std::vector<Eigen::Vector2d>& points) {
+  if (counters_.map_updates > 0 && !map_update_due(result.T_map_base)) return;
+  map_.update(result.T_map_base, T_base_laser_.translation(), points);
+  T_map_base_last_update_ = result.T_map_base;
+  counters_.map_tiles_evicted += static_cast<int64_t>(map_.bound_memory(
+      result.T_map_base.translation(), static_cast<std::size_t>(config_.map.max_bytes)));
+  ++counters_.map_updates;
+  result.map_updated = true;
+}
+
+FrontendResult Frontend::process_own(const Scan& scan) {
+  bool by_travel = false;
+  FrontendResult result = measure(scan, by_travel);
+  if (result.status == ScanStatus::kDropped) return result;
+  const bool matched = result.status == ScanStatus::kMatched;
+  lagging_ = lagging_ || (by_travel && config_.matcher.sparse_lag);
+  if (!lagging_) {
+    if (matched) add_to_map(result, points_buffer_);
+    T_emitted_last_ = result.T_map_base;
+    return result;
+  }
+  // One scan behind: the held scan is settled with this one's pose, then this one is held, its
+  // map update journaled so that settling can move it.
+  FrontendResult out;
+  out.status = ScanStatus::kHeld;
+  out.utime = result.utime;
+  if (held_) {
+    const int64_t revised = counters_.scans_revised;
+    out = settle(*held_, &result);
+    if (matched && counters_.scans_revised > revised) {
+      // This scan was matched against the held one where it no longer is: again, from its pose.
+      const MatchResult m = match_scan_wide(map_, matched_buffer_, {result.T_map_base},
+                                            config_.matcher, &out.T_map_base);
+      result.T_map_base = m.T_map_base;
+      result.covariance = m.covariance;
+      result.matched_points = m.points;
+      result.iterations += m.iterations;
+      result.residual_rms = m.residual_rms;
+      T_map_base_last_ = m.T_map_base;
+      covariance_last_ = m.covariance;
+    }
+  }
+  Held next{result, {}, {}, T_emitted_last_, T_map_base_last_update_};
+  if (matched) {
+    next.points = points_buffer_;
+    next.points_matched = matched_buffer_;
+    map_.begin_journal();
+    add_to_map(next.result, next.points);
+  }
+  held_ = std::move(next);
+  return out;
+}
+
+double Frontend::lag_score(const Held& held, const Pose2& T, const Pose2& T_next) const {
+  const int level = std::min(1, map_.levels() - 1);
+  const double evidence = pose_evidence(map_.level(level), held.points_matched, T);
+  double cost = step_prior_cost(step_prior(config_.matcher, held.T_before), T) +
+                step_prior_cost(step_prior(config_.matcher, T), T_next);
+  // A step longer than the log's steps usually are (kLongStepFactor times the 90th percentile
+  // of the last settled ones) loses sparse_lag_long_weight per point at kLongStepScaleM beyond.
+  const std::size_t n = std::min(step_count_, kRecentSteps);
+  if (n >= kRecentSteps / 2) {
+    std::vector<double> lengths(recent_steps_m_.begin(), recent_steps_m_.begin() + n);
+    const std::size_t k90 = n * 9 / 10;
+    std::nth_element(lengths.begin(), lengths.begin() + k90, lengths.end());
+    const double limit = kLongStepFactor * lengths[k90];
+    for (const double length : {between(held.T_before, T).translation().norm(),
+                                between(T, T_next).translation().norm()}) {
+      const double e = std::max(0.0, length - limit) / kLongStepScaleM;
+      cost += config_.matcher.sparse_lag_long_weight * e * e;
+    }
+  }
+  return evidence - cost;
+}
+
+FrontendResult Frontend::settle(Held& held, const FrontendResult* next) {
+  FrontendResult& r = held.result;
+  if (r.status == ScanStatus::kMatched && r.sparse && next != nullptr &&
+      next->status == ScanStatus::kMatched && next->sparse) {
+    // Where the scan fits best may not be where it was (a room mapped differently on an earlier
+    // pass): the pose halfway between the steps around it is a second candidate, matched in a
+    // narrow window, and the better of the two by the lag's score is kept.
+    const Pose2 mid =
+        held.T_before * Pose2::exp(0.5 * between(held.T_before, next->T_map_base).log());
+    const Pose2 d = between(mid, r.T_map_base);
+    if (d.translation().norm() > config_.matcher.sparse_lag_window_m ||
+        std::abs(d.theta()) > config_.matcher.sparse_lag_window_rad) {
+      // Compared in the map without the scan itself.
+      map_.rollback();
+      if (r.map_updated) {
+        T_map_base_last_update_ = held.T_last_update_before;
+        --counters_.map_updates;
+        r.map_updated = false;
+      }
+      MatcherConfig narrow = config_.matcher;
+      narrow.wide_search_linear_window_m = config_.matcher.sparse_lag_window_m;
+      narrow.wide_search_angular_window_rad = config_.matcher.sparse_lag_window_rad;
+      const MatchResult alt =
+          match_scan_wide(map_, held.points_matched, {mid}, narrow, &held.T_before);
+      const double own = lag_score(held, r.T_map_base, next->T_map_base);
+      const double other = lag_score(held, alt.T_map_base, next->T_map_base);
+      if (!agrees(alt.T_map_base, r.T_map_base)) {
+        const Pose2 T_own = r.T_map_base;
+        const bool revise = other > own + config_.matcher.sparse_lag_margin;
+        if (revise) {
+          ++counters_.scans_revised;
+          r.T_map_base = alt.T_map_base;
+          r.covariance = alt.covariance;
+          r.matched_points = alt.points;
+          r.residual_rms = alt.residual_rms;
+        }
+        // The candidate not taken is a second place the pose may be: its offset joins the
+        // covariance with the weight the wide search's spread would give it (its score, summed
+        // over the points, below the other's, in temperatures).
+        const double temperature = config_.matcher.wide_search_temperature;
+        if (temperature > 0.0) {
+          const double gap =
+              std::abs(own - other) * static_cast<double>(held.points_matched.size()) / temperature;
+          const Pose2& T_other = revise ? T_own : alt.T_map_base;
+          Eigen::Vector3d offset;
+          offset.head<2>() = T_other.translation() - r.T_map_base.translation();
+          offset.z() = wrap_angle(T_other.theta() - r.T_map_base.theta());
+          r.covariance += offset * offset.transpose() / (1.0 + std::exp(gap));
+        }
+      }
+      add_to_map(r, held.points);
+    }
+  }
+  map_.end_journal();
+  recent_steps_m_[step_count_ % kRecentSteps] =
+      between(held.T_before, r.T_map_base).translation().norm();
+  ++step_count_;
+  T_emitted_last_ = r.T_map_base;
+  return r;
+}
+
+std::optional<FrontendResult> Frontend::finish_own() {
+  if (!held_) return std::nullopt;
+  FrontendResult r = settle(*held_, nullptr);
+  held_.reset();
+  return r;
+}
+
+std::optional<FrontendResult> Frontend::finish() {
+  std::vector<Pose2> last{T_emitted_last_};
+  for (const auto& m : members_) last.push_back(m->T_emitted_last_);
+  std::optional<FrontendResult> result = finish_own();
+  std::vector<FrontendResult> member_results;
+  for (auto& m : members_) {
+    const std::optional<FrontendResult> r = m->finish_own();
+    member_results.push_back(r ? *r : FrontendResult{});
+  }
+  if (result && !members_.empty()) vote(*result, member_results, last);
   return result;
 }
 

@@ -13,7 +13,10 @@
 //   5. update the map when the pose moved or turned past a threshold since the last update.
 // Sparse scans go through this pipeline in several frontends at once (an ensemble, see
 // MatcherConfig::sparse_ensemble_members), each with its own map on a grid offset by a fraction
-// of a cell; the published pose is the previous one times the step most of them agree on.
+// of a cell; the published pose is the previous one times the step most of them agree on. On a
+// log subsampled by travel each frontend runs one scan behind (MatcherConfig::sparse_lag): a
+// scan's map update is journaled until the next scan has been matched, and its pose may then
+// move to where the pair of steps around it says (its map update moving with it).
 // A scan with too few valid points, or whose match on a scanner's stream lands far from the
 // prediction with a poor fit, gets the predicted pose (flagged); a scan whose time does not
 // advance, or whose last point is before its first, is dropped. Each case is counted.
@@ -40,10 +43,15 @@ enum class ScanStatus {
   kMatched,    // pose measured by matching (the first scan: its pose is the config's initial_pose)
   kPredicted,  // pose predicted from motion: too few valid points, or an unverified match
   kDropped,    // time does not advance or is inconsistent: no pose
+  kHeld,       // no pose yet: a log subsampled by travel is one scan behind (MatcherConfig::
+               // sparse_lag); the pose comes with the next scan's result or from finish()
 };
 
 struct FrontendResult {
   ScanStatus status = ScanStatus::kDropped;
+  bool has_pose() const {
+    return status == ScanStatus::kMatched || status == ScanStatus::kPredicted;
+  }
   int64_t utime = 0;  // [us] time the pose is valid at: the scan's last point
   Pose2 T_map_base;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // (x [m], y [m], theta [rad])
@@ -75,6 +83,7 @@ struct FrontendCounters {
   int64_t imu_dropped_time = 0;  // IMU samples not after the previous one
   int64_t steps_disputed = 0;    // sparse ensemble: steps on which not every member agreed
   int64_t steps_outvoted = 0;    // ... on which this frontend's own step lost the vote
+  int64_t scans_revised = 0;     // sparse lag: poses moved once the next scan was matched
 };
 
 // The vote of a sparse-scan ensemble on one step (each member's step from its last pose to its
@@ -98,8 +107,13 @@ class Frontend {
   std::optional<int64_t> last_imu_utime() const;
 
   // One pose per scan (status kDropped: none). With a sparse-scan ensemble, the pose is the
-  // previous one times the step most members agree on (see MatcherConfig).
+  // previous one times the step most members agree on (see MatcherConfig). On a log subsampled
+  // by travel (with MatcherConfig::sparse_lag) the frontend runs one scan behind from the scan
+  // where it notices: the result is the previous scan's pose (its utime says which), the first
+  // such call returns kHeld, and finish() gives the last scan's pose at the end of the stream.
   FrontendResult process(const Scan& scan);
+  // The pose of the scan still held by the lag, if any (at the end of the stream).
+  std::optional<FrontendResult> finish();
 
   const FrontendCounters& counters() const { return counters_; }
   const MapPyramid& map() const { return map_; }
@@ -108,11 +122,32 @@ class Frontend {
   const FrontendConfig& config() const { return config_; }
 
  private:
-  // The pipeline of one frontend: its own pose in its own map.
+  // A held scan (sparse lag): its result from its own match, its points (base frame, deskewed;
+  // all valid ones for the map, subsampled for matching) and the pose its step starts from.
+  struct Held {
+    FrontendResult result;
+    std::vector<Eigen::Vector2d> points, points_matched;
+    Pose2 T_before;
+    Pose2 T_last_update_before;  // the pose of the map's last update before this scan's
+  };
+  // The pipeline of one frontend: its own pose in its own map (one scan behind when lagging).
   FrontendResult process_own(const Scan& scan);
-  // Votes on the step from the last pose (`last`: this frontend's, then each member's, before the
-  // scan) among this frontend and the ensemble's members; `result` (this frontend's own) becomes
-  // the published pose.
+  // Matching and motion state of one scan, without the map update; the scan's valid points stay
+  // in points_buffer_, subsampled in matched_buffer_.
+  FrontendResult measure(const Scan& scan, bool& by_travel);
+  // Settles the held scan's pose given the next scan's own result (none at the end), moving its
+  // journaled map update if the pose moves, and returns it.
+  FrontendResult settle(Held& held, const FrontendResult* next);
+  // The map update of a matched scan at its pose, when due (always for the first).
+  void add_to_map(FrontendResult& result, const std::vector<Eigen::Vector2d>& points);
+  // The lag's score of the held scan at T (see MatcherConfig::sparse_lag): mean evidence per
+  // point minus the step priors of the steps into T and from T to the next scan's pose.
+  double lag_score(const Held& held, const Pose2& T, const Pose2& T_next) const;
+  // Finishes this frontend's own held scan, if any.
+  std::optional<FrontendResult> finish_own();
+  // Votes on the step from the last pose (`last`: the one this frontend, then each member, last
+  // gave before this result) among this frontend and the ensemble's members; `result` (this
+  // frontend's own) becomes the published pose.
   void vote(FrontendResult& result, const std::vector<FrontendResult>& member_results,
             const std::vector<Pose2>& last);
   // Valid readings as points in the base frame with their times; counts invalid ones.
@@ -154,6 +189,15 @@ class Frontend {
   std::array<int64_t, kRecentIntervals> recent_intervals_us_{};
   std::size_t interval_count_ = 0;
 
+  // Sparse lag: whether this stream runs one scan behind, the scan held, the pose last emitted
+  // (own map frame), and the lengths of the last settled steps [m] (a ring, how many were seen).
+  bool lagging_ = false;
+  std::optional<Held> held_;
+  Pose2 T_emitted_last_;
+  static constexpr std::size_t kRecentSteps = 30;
+  std::array<double, kRecentSteps> recent_steps_m_{};
+  std::size_t step_count_ = 0;
+
   // Sparse-scan ensemble: the other members (each a frontend of one, its grid offset); the last
   // published pose; how many scans in a row were not sparse (three drop the members: a scanner's
   // stream).
@@ -165,7 +209,7 @@ class Frontend {
   std::size_t beam_n_ = 0;
   double beam_angle_first_ = 0.0, beam_angle_step_ = 0.0;
   std::vector<Eigen::Vector2d> beam_directions_;
-  std::vector<Eigen::Vector2d> points_buffer_;
+  std::vector<Eigen::Vector2d> points_buffer_, matched_buffer_;
   std::vector<int64_t> utimes_buffer_;
 };
 

@@ -90,12 +90,13 @@ struct MatcherConfig {
   // is offset from the others' by a fraction of a cell and turned by under a degree; each scan's
   // published step is the one most of them agree on (within 0.15 m and 0.05 rad), and the spread
   // of their steps is added to its covariance. On a sparse log the outcome of one frontend turns
-  // on such offsets: on CARMEN aces, from 8 offsets, one frontend jumps 0.67 to 2.3 m and 3 times
-  // loses track (RPE over 10 m 1.5 to 1.9 m); the members mostly go wrong at different scans, and
-  // five of them jump 0.19 to 0.92 m (7 of 8 under 0.5 m) with RPE over 10 m at most 0.27 m
+  // on such offsets: on CARMEN aces, from 8 offsets, one frontend jumps 0.67 to 2.0 m and 3 times
+  // loses track (RPE over 10 m 1.5 to 2.2 m); the members mostly go wrong at different scans, and
+  // five of them jump 0.20 to 0.88 m (7 of 8 under 0.5 m) with RPE over 10 m at most 0.24 m
   // (scripts/frontend-sensitivity.sh aces, --members 1). Steps most members misjudge together
-  // remain (intel scan 761, 0.87 m). Costs this many times the sparse path's time; a scanner's
-  // stream (three scans in a row that are not sparse) drops the extra members. 1 runs one frontend.
+  // remain (intel scan 761, 0.87 m, until sparse_lag). Costs this many times the sparse path's
+  // time; a scanner's stream (three scans in a row that are not sparse) drops the extra members.
+  // 1 runs one frontend.
   int sparse_ensemble_members = 5;
   // Prior on the shape of a sparse scan's step (wide_search.hpp, StepPrior), from this frontend's
   // last pose: a log subsampled by travel rarely steps both under sparse_step_min_travel_m and
@@ -117,6 +118,26 @@ struct MatcherConfig {
   double sparse_step_short_weight = 0.2;
   double sparse_step_off_arc_free_m = 0.2;
   double sparse_step_off_arc_weight = 0.1;
+  // Sparse lag: on a log subsampled by travel (as for the step prior) the frontend runs one scan
+  // behind, so that the scan after can still move a scan's pose. Where a scan fits a map
+  // that an earlier pass made otherwise (a door then open, that pass's drift) better at a wrong
+  // pose, the next scan usually lands right again, and the pair of steps shows it: once scan
+  // k+1 is matched, scan k's pose is compared with the best pose within sparse_lag_window_m
+  // and sparse_lag_window_rad of the pose halfway between scans k-1 and k+1 (if it lies
+  // outside that window), both scored without scan k in the map: evidence per point minus the
+  // step prior of the steps into and out of the pose, minus sparse_lag_long_weight per point
+  // at 0.3 m beyond 1.25 times the log's usual step (90th percentile of the last 30). The
+  // other pose is taken if it scores sparse_lag_margin per point more; scan k's map update then
+  // moves (undone exactly, see OccupancyGrid's journal), and scan k+1 is matched again. On
+  // intel, scan 761 was matched 0.73 m short and 20 degrees off (the largest jump, 0.87 m); the
+  // lag moves it and the largest jump is 0.47 m (scripts/eval-carmen.sh intel --stages frontend,
+  // with and without). The frontend publishes each pose one scan late on such logs (a second
+  // there); false gives each pose at once.
+  bool sparse_lag = true;
+  double sparse_lag_window_m = 0.3;
+  double sparse_lag_window_rad = 0.2;
+  double sparse_lag_long_weight = 0.2;  // [per point]
+  double sparse_lag_margin = 0.1;       // [per point, evidence -1 to 1]
 
   template <class V>
   void visit(V& v) {
@@ -144,6 +165,11 @@ struct MatcherConfig {
     v("sparse_step_short_weight", sparse_step_short_weight);
     v("sparse_step_off_arc_free_m", sparse_step_off_arc_free_m);
     v("sparse_step_off_arc_weight", sparse_step_off_arc_weight);
+    v("sparse_lag", sparse_lag);
+    v("sparse_lag_window_m", sparse_lag_window_m);
+    v("sparse_lag_window_rad", sparse_lag_window_rad);
+    v("sparse_lag_long_weight", sparse_lag_long_weight);
+    v("sparse_lag_margin", sparse_lag_margin);
   }
 };
 
@@ -247,6 +273,10 @@ inline std::optional<std::string> config_problem(const FrontendConfig& c) {
         c.matcher.sparse_step_off_arc_free_m >= 0.0))
     return "matcher.sparse_step_short_weight, sparse_step_off_arc_weight and "
            "sparse_step_off_arc_free_m must not be negative";
+  if (!(c.matcher.sparse_lag_window_m > 0.0 && c.matcher.sparse_lag_window_rad > 0.0))
+    return "matcher.sparse_lag_window_m and sparse_lag_window_rad must be positive";
+  if (!(c.matcher.sparse_lag_long_weight >= 0.0 && c.matcher.sparse_lag_margin >= 0.0))
+    return "matcher.sparse_lag_long_weight and sparse_lag_margin must not be negative";
   return std::nullopt;
 }
 

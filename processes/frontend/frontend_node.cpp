@@ -32,8 +32,11 @@ void FrontendNode::flush(bool all) {
     if (!ready) break;
     const FrontendResult result = frontend_.process(scan);
     pending_.pop_front();
-    if (result.status != ScanStatus::kDropped) publish(result);
+    if (result.has_pose()) publish(result);
   }
+  if (!all) return;
+  // The end of the stream: the scan the lag still holds (sparse_lag) gets its pose.
+  if (const auto result = frontend_.finish()) publish(*result);
 }
 
 void FrontendNode::publish(const FrontendResult& result) {
@@ -69,6 +72,7 @@ void FrontendNode::report_counters() {
   counters_("imu_dropped", static_cast<double>(c.imu_dropped_time));
   counters_("steps_disputed", static_cast<double>(c.steps_disputed));
   counters_("steps_outvoted", static_cast<double>(c.steps_outvoted));
+  counters_("scans_revised", static_cast<double>(c.scans_revised));
 }
 
 }  // namespace traverse::frontend

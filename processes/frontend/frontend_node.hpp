@@ -2,6 +2,8 @@
 // child "base", one per scan). A scan waits until IMU samples cover its last point (or until a
 // scan imu_wait_us later has arrived, or for good when no IMU publishes), because a log player
 // delivers a sweep at its first point's time, before the IMU samples taken during the sweep.
+// On a log subsampled by travel a pose comes one scan late (MatcherConfig::sparse_lag), the last
+// one at shutdown (flush(true)).
 #pragma once
 
 #include <deque>
@@ -20,7 +22,8 @@ class FrontendNode {
   using CounterSink = std::function<void(const std::string& name, double value)>;
   FrontendNode(Bus& bus, const FrontendConfig& config, CounterSink counters = {});
 
-  // Processes every scan that is ready; all waiting scans if `all` (at shutdown).
+  // Processes every scan that is ready; all waiting scans, and the one the lag holds, if `all`
+  // (at shutdown).
   void flush(bool all = false);
   // Copies the frontend's counters to the sink (status counters of the process).
   void report_counters();

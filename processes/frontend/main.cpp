@@ -1,5 +1,6 @@
 // traverse-frontend: Hector-style scan-to-map matcher. Subscribes to planar scans and IMU samples,
-// publishes one pose per scan (map -> base) with its covariance.
+// publishes one pose per scan (map -> base) with its covariance (on a log subsampled by travel,
+// one scan late: matcher.sparse_lag).
 #include <spdlog/spdlog.h>
 
 #include "frontend_node.hpp"

@@ -47,6 +47,10 @@ OccupancyGrid::Tile& OccupancyGrid::tile_at(int64_t tx, int64_t ty) {
   const uint64_t key = tile_key(tx, ty);
   if (cached_tile_ && key == cached_key_) return *cached_tile_;
   auto& slot = tiles_[key];
+  if (journal_open_ && !journal_.contains(key)) {
+    journal_.emplace(key, slot ? std::make_unique<Tile>(*slot) : nullptr);
+    if (slot) ++journal_saved_;
+  }
   if (!slot) slot = std::make_unique<Tile>();
   cached_key_ = key;
   cached_tile_ = slot.get();
@@ -124,6 +128,10 @@ void OccupancyGrid::trace_free(int64_t x0, int64_t y0, int64_t x1, int64_t y1) {
 void OccupancyGrid::update(const Eigen::Vector2d& origin_map,
                            const std::vector<Eigen::Vector2d>& hits_map,
                            const std::vector<double>* incidence_sin) {
+  if (journal_open_) {  // a tile cached by a read since the journal opened was not saved
+    cached_key_ = ~0ULL;
+    cached_tile_ = nullptr;
+  }
   if (++stamp_ == 0) {  // stamps wrapped: forget old ones so no cell looks already touched
     for (auto& [key, tile] : tiles_) tile->stamp.fill(0);
     stamp_ = 1;
@@ -173,6 +181,30 @@ Eigen::Vector2d OccupancyGrid::max_corner() const {
     hi = hi.cwiseMax(Eigen::Vector2d(tx + 1, ty + 1) * kTileSize * resolution_m_);
   }
   return hi;
+}
+
+void OccupancyGrid::begin_journal() {
+  end_journal();  // also drops the cached tile: the next touch must look it up (and save it)
+  journal_open_ = true;
+}
+
+void OccupancyGrid::rollback() {
+  for (auto& [key, saved] : journal_) {
+    if (saved) {
+      tiles_[key] = std::move(saved);
+    } else {
+      tiles_.erase(key);
+    }
+  }
+  end_journal();
+}
+
+void OccupancyGrid::end_journal() {
+  journal_.clear();
+  journal_saved_ = 0;
+  journal_open_ = false;
+  cached_key_ = ~0ULL;
+  cached_tile_ = nullptr;
 }
 
 std::size_t OccupancyGrid::evict_farthest(const Eigen::Vector2d& p_map, std::size_t max_bytes) {

@@ -43,8 +43,9 @@ class OccupancyGrid {
   void update(const Eigen::Vector2d& origin_map, const std::vector<Eigen::Vector2d>& hits_map,
               const std::vector<double>* incidence_sin = nullptr);
 
-  // Bytes held by the cells (tiles x tile size); the map's memory use to report.
-  std::size_t memory_bytes() const { return tiles_.size() * sizeof(Tile); }
+  // Bytes held by the cells (tiles x tile size, and the tiles an open journal saved); the map's
+  // memory use to report.
+  std::size_t memory_bytes() const { return (tiles_.size() + journal_saved_) * sizeof(Tile); }
   std::size_t tile_count() const { return tiles_.size(); }
   // Extent of the observed area [m]: min and max corner of all tiles, zero if empty.
   Eigen::Vector2d min_corner() const;
@@ -52,6 +53,14 @@ class OccupancyGrid {
 
   // Drops the tiles farthest from `p_map` until memory_bytes() <= max_bytes. Returns tiles dropped.
   std::size_t evict_farthest(const Eigen::Vector2d& p_map, std::size_t max_bytes);
+
+  // Journal: while open, update() first saves each tile it changes, so that rollback() can put
+  // the grid back exactly as begin_journal() found it (log-odds are clamped: an update cannot
+  // be undone by its opposite). end_journal() keeps the changes. Opening a journal ends the last.
+  void begin_journal();
+  void rollback();
+  void end_journal();
+  bool journal_open() const { return journal_open_; }
 
  private:
   struct Tile {
@@ -71,6 +80,10 @@ class OccupancyGrid {
   std::array<float, 256> probability_of_{};  // indexed by log-odds + 128
   std::unordered_map<uint64_t, std::unique_ptr<Tile>> tiles_;
   uint8_t stamp_ = 0;
+  // Tiles as they were when the journal opened (null: the tile did not exist).
+  bool journal_open_ = false;
+  std::unordered_map<uint64_t, std::unique_ptr<Tile>> journal_;
+  std::size_t journal_saved_ = 0;  // entries holding a tile
   // One-entry cache of the last tile looked up: consecutive look-ups mostly hit the same tile.
   mutable uint64_t cached_key_ = ~0ULL;
   mutable Tile* cached_tile_ = nullptr;

@@ -53,6 +53,18 @@ std::size_t MapPyramid::bound_memory(const Eigen::Vector2d& p_map, std::size_t m
   return dropped;
 }
 
+void MapPyramid::begin_journal() {
+  for (auto& grid : grids_) grid.begin_journal();
+}
+
+void MapPyramid::rollback() {
+  for (auto& grid : grids_) grid.rollback();
+}
+
+void MapPyramid::end_journal() {
+  for (auto& grid : grids_) grid.end_journal();
+}
+
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
                                  const Pose2& T_map_base) {

@@ -43,6 +43,11 @@ class MapPyramid {
   std::size_t memory_bytes() const;
   // Drops far tiles (all levels) so the total stays under max_bytes. Returns tiles dropped.
   std::size_t bound_memory(const Eigen::Vector2d& p_map, std::size_t max_bytes);
+  // The journal of every level (OccupancyGrid::begin_journal): updates made while it is open
+  // can be undone exactly.
+  void begin_journal();
+  void rollback();
+  void end_journal();
 
  private:
   std::vector<OccupancyGrid> grids_;

@@ -14,7 +14,51 @@ constexpr double kSurfaceMargin = 8.0;
 // A step off its arc (sideways or backwards) by StepPrior::off_arc_free_m plus this loses
 // StepPrior::off_arc_weight per point, quadratically.
 constexpr double kOffArcScaleM = 0.3;
+
+// Tangent of half a step's turn: a chord of an arc turning by `turn` points half as far round
+// (sideways = forward * tan).
+double tan_half_turn(double turn) {
+  return std::tan(std::clamp(0.5 * turn, -M_PI / 4.0, M_PI / 4.0));
+}
+
+// StepPrior's cost per point of a step of `length` [m], `forward` [m] along the last heading,
+// `side` [m] off the arc through its `turn` [rad] (0 on it).
+double step_shape_cost(const StepPrior& sp, double length, double forward, double side,
+                       double turn) {
+  double cost = 0.0;
+  const double inside = 1.0 - std::max(length / sp.min_travel_m, std::abs(turn) / sp.min_turn_rad);
+  if (inside > 0.0) cost += sp.short_weight * inside * inside;
+  const double e_side = std::max(0.0, side - sp.off_arc_free_m) / kOffArcScaleM;
+  const double e_back = std::max(0.0, -forward - sp.off_arc_free_m) / kOffArcScaleM;
+  return cost + sp.off_arc_weight * (e_side * e_side + e_back * e_back);
+}
 }  // namespace
+
+double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+                     const Pose2& T_map_base) {
+  if (points_base.empty()) return 0.0;
+  const double res = grid.resolution();
+  double sum = 0.0;
+  for (const auto& p : points_base) {
+    const Eigen::Vector2d q = T_map_base * p;
+    const int64_t i = std::llround(q.x() / res), j = std::llround(q.y() / res);
+    const double own = 2.0 * (grid.cell_probability(i, j) - 0.5);
+    double m = 0.0;  // as the search's table: blurred by half the occupied neighbours
+    for (int64_t dj = -1; dj <= 1; ++dj)
+      for (int64_t di = -1; di <= 1; ++di)
+        m = std::max(m, 2.0 * (grid.cell_probability(i + di, j + dj) - 0.5));
+    sum += m > 0.0 ? std::max(own, 0.5 * m) : own;
+  }
+  return sum / static_cast<double>(points_base.size());
+}
+
+double step_prior_cost(const StepPrior& sp, const Pose2& T_map_base) {
+  if (!(sp.min_travel_m > 0.0 && sp.min_turn_rad > 0.0)) return 0.0;
+  const Pose2 step = between(sp.T_last, T_map_base);
+  const Eigen::Vector2d v = step.translation();
+  return step_shape_cost(sp, v.norm(), v.x(), std::abs(v.y() - v.x() * tan_half_turn(step.theta())),
+                         step.theta());
+}
 
 WideSearchResult wide_search(const OccupancyGrid& grid,
                              const std::vector<Eigen::Vector2d>& points_base, const Pose2& T_center,
@@ -145,14 +189,12 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
     for (int a = 0; a < 2 * n_angles + 1; ++a) {
       step_turn.push_back(
           wrap_angle(T_center.theta() + (a - n_angles) * angle_step - step_prior->T_last.theta()));
-      step_tan_half.push_back(
-          std::tan(std::clamp(0.5 * step_turn.back(), -M_PI / 4.0, M_PI / 4.0)));
+      step_tan_half.push_back(tan_half_turn(step_turn.back()));
     }
   }
   const auto step_cost = [&](int a, int dx, int dy, int size) {
     if (!use_step) return 0.0;
-    const StepPrior& sp = *step_prior;
-    const double turn = step_turn[a], tan_half = step_tan_half[a];
+    const double tan_half = step_tan_half[a];
     double length = 0.0, forward = -std::numeric_limits<double>::infinity();
     double side_lo = std::numeric_limits<double>::infinity(), side_hi = -side_lo;
     for (const int cx : {dx, dx + size - 1}) {
@@ -164,14 +206,8 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
         side_hi = std::max(side_hi, v.y() - v.x() * tan_half);
       }
     }
-    double cost = 0.0;
-    const double inside =
-        1.0 - std::max(length / sp.min_travel_m, std::abs(turn) / sp.min_turn_rad);
-    if (inside > 0.0) cost += sp.short_weight * inside * inside;
     const double side = side_lo > 0.0 ? side_lo : (side_hi < 0.0 ? -side_hi : 0.0);
-    const double e_side = std::max(0.0, side - sp.off_arc_free_m) / kOffArcScaleM;
-    const double e_back = std::max(0.0, -forward - sp.off_arc_free_m) / kOffArcScaleM;
-    return cost + sp.off_arc_weight * (e_side * e_side + e_back * e_back);
+    return step_shape_cost(*step_prior, length, forward, side, step_turn[a]);
   };
   const auto penalty = [&](int a, int dx, int dy, int size) {
     const double theta = (a - n_angles) * angle_step;

@@ -51,6 +51,13 @@ struct StepPrior {
   double off_arc_free_m = 0.0;
   double off_arc_weight = 0.0;  // [per point]
 };
+// The search's score of one pose without priors: mean evidence per point, -1 to 1 (as
+// WideSearchResult::score).
+double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+                     const Pose2& T_map_base);
+// The step prior's cost per point of the step to T_map_base (0 without a prior).
+double step_prior_cost(const StepPrior& prior, const Pose2& T_map_base);
+
 WideSearchResult wide_search(const OccupancyGrid& grid,
                              const std::vector<Eigen::Vector2d>& points_base, const Pose2& T_center,
                              double linear_window_m, double angular_window_rad,

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 
 #include "carmen_log.hpp"
 #include "carmen_node.hpp"
@@ -38,13 +39,14 @@ Metrics run_log(const std::string& path) {
   // The scans as traverse-carmen publishes them (configs/carmen.yaml defaults) and
   // traverse-frontend reads them: the same figures as scripts/eval-carmen.sh --stages frontend.
   const carmen::CarmenConfig carmen_config;
-  while (auto s = reader.next()) {
-    const Scan scan = to_planar_scan(carmen::to_scan_message(*s, carmen_config));
-    const FrontendResult r = frontend.process(scan);
-    if (r.status == ScanStatus::kDropped) continue;
+  // The reference by scan time: on a log subsampled by travel the frontend's result is the
+  // previous scan's (matcher.sparse_lag), and finish() gives the last.
+  std::map<int64_t, Pose2> reference;
+  auto take = [&](const FrontendResult& r) {
+    if (!r.has_pose()) return;
     if (r.status == ScanStatus::kPredicted) ++m.predicted;
     if (r.searched) ++m.searched;
-    ref.push_back({r.utime, Pose2(s->x_m, s->y_m, s->theta_rad)});
+    ref.push_back({r.utime, reference.at(r.utime)});
     est.push_back({r.utime, r.T_map_base, r.covariance});
     // CARMEN_TRACE=1: every step, reference against estimate, to find where tracking fails.
     if (std::getenv("CARMEN_TRACE") && ref.size() > 1) {
@@ -55,7 +57,13 @@ Metrics run_log(const std::string& path) {
                   dr.y(), dr.theta() * 57.3, de.x(), de.y(), de.theta() * 57.3,
                   (dr.translation() - de.translation()).norm(), r.residual_rms);
     }
+  };
+  while (auto s = reader.next()) {
+    const Scan scan = to_planar_scan(carmen::to_scan_message(*s, carmen_config));
+    reference[scan.utime_last] = Pose2(s->x_m, s->y_m, s->theta_rad);
+    take(frontend.process(scan));
   }
+  if (const auto r = frontend.finish()) take(*r);
   m.scans = static_cast<int>(est.size());
   m.ev = evaluator::evaluate(est, ref, evaluator::EvaluatorConfig{});
   return m;
@@ -104,23 +112,24 @@ TEST_P(CarmenLog, TracksReference) {
 }
 
 // Bounds a little above what the frontend reaches (measured, configs/frontend.yaml with its
-// five-member ensemble and its step prior for sparse scans; rpe_1m / rpe_10m / max_jump):
-// freiburg-079 0.046 / 0.098 / 0.18 m, intel 0.069 / 0.131 / 0.87 m, aces 0.061 / 0.150 / 0.22 m,
-// csail 0.056 / 0.144 / 0.41 m. Issue 4 asks for max_jump under 0.5 m on all four: not reached on
-// intel (one scan entering a room that an earlier pass mapped otherwise, matched 20 degrees off).
+// five-member ensemble, its step prior for sparse scans and its lag of one scan on logs
+// subsampled by travel; rpe_1m / rpe_10m / max_jump): freiburg-079 0.046 / 0.098 / 0.18 m, intel
+// 0.060 / 0.127 / 0.47 m, aces 0.061 / 0.145 / 0.22 m, csail 0.056 / 0.144 / 0.41 m: issue 4's
+// largest jump under 0.5 m on all four. Without the lag (matcher.sparse_lag false) intel jumped
+// 0.87 m: scan 761, entering a room that an earlier pass mapped otherwise, matched 20 degrees off.
 // Without the step prior (matcher.sparse_step_*), aces jumped 1.03 m (rpe_10m 0.47 m): steps
 // along corridors stalled. These bounds guard the shipped start only; on a sparse log the outcome
 // turns on where the grid's cells fall (scripts/frontend-sensitivity.sh). Before the gate on far
 // searched poses (search_max_unverified_m), freiburg-079 jumped 0.75 m at a scan crowded by
 // something near the scanner. Before the wide search for sparse scans, intel, aces and csail lost
 // track (rpe_10m 2.97 / 4.31 / 4.18 m). Steps outside the 99 % ellipse of their covariance: intel
-// 2.6 %, aces 0 %, csail 6.2 % (median NEES 0.37 / 0.23 / 0.71); with the Gauss-Newton covariance
+// 2.5 %, aces 0 %, csail 6.2 % (median NEES 0.36 / 0.23 / 0.71); with the Gauss-Newton covariance
 // alone and one frontend (matcher.wide_search_temperature 0, sparse_ensemble_members 1): 70 / 60 /
-// 60 %, median 19.0 / 13.3 / 14.5. freiburg-079 is a scanner's stream (Gauss-Newton covariance):
+// 60 %, median 18.7 / 13.3 / 14.5. freiburg-079 is a scanner's stream (Gauss-Newton covariance):
 // 73.5 % outside, median 23.8, not checked.
 INSTANTIATE_TEST_SUITE_P(Logs, CarmenLog,
                          ::testing::Values(LogCase{"freiburg-079", 4700, 0.06, 0.15, 0.5},
-                                           LogCase{"intel", 900, 0.15, 0.2, 1.0, 0.1},
+                                           LogCase{"intel", 900, 0.1, 0.2, 0.5, 0.1},
                                            LogCase{"aces", 430, 0.1, 0.25, 0.5, 0.05},
                                            LogCase{"csail", 400, 0.1, 0.25, 0.5, 0.2}),
                          [](const auto& info) {

@@ -82,6 +82,39 @@ TEST_F(FrontendNodeTest, PublishesOnePosePerScanWithoutImu) {
   EXPECT_GT(counters_.at("map_bytes"), 0);
 }
 
+TEST_F(FrontendNodeTest, LogSubsampledByTravelIsPublishedOneScanLateAndTheLastAtShutdown) {
+  FrontendConfig config = config_;
+  config.pose_channel = "TEST_POSE_SPARSE";
+  config.matcher.sparse_ensemble_members = 1;
+  ASSERT_TRUE(config.matcher.sparse_lag);
+  FrontendNode node(bus_, config);
+  std::vector<pose2d_t> poses;
+  bus_.subscribe<pose2d_t>("TEST_POSE_SPARSE", [&](const pose2d_t& p) { poses.push_back(p); });
+  // Scans 1 s apart, walking 0.3 m per scan along x.
+  std::vector<int64_t> utimes;
+  for (int k = 0; k < 9; ++k) {
+    synthetic::SweepSpec spec;
+    spec.n_ranges = 900;
+    spec.angle_step = 300.0 * M_PI / 180.0 / 899.0;
+    spec.utime_first = 1'000'000 + k * 1'000'000LL;
+    const Pose2 T(-1.5 + 0.3 * k, 0.0, 0.0);
+    auto m = to_message(synthetic::make_sweep(
+        synthetic::room(), [&](int64_t) { return T; }, Pose2(), spec));
+    utimes.push_back(m.utime_last);
+    bus_.publish("TEST_SCAN", m);
+  }
+  handle_all();
+  // Six scans show the stream's pace; from the seventh on the pose comes with the next scan.
+  ASSERT_EQ(poses.size(), 8u);
+  node.flush(true);
+  handle_all();
+  ASSERT_EQ(poses.size(), 9u);
+  for (int k = 0; k < 9; ++k) {
+    EXPECT_EQ(poses[k].utime, utimes[k]) << k;
+    EXPECT_NEAR(poses[k].x - poses[0].x, 0.3 * k, 0.05) << k;
+  }
+}
+
 TEST_F(FrontendNodeTest, ScanWaitsForImuCoveringItsLastPoint) {
   auto i0 = imu_at(900'000);
   bus_.publish(config_.imu_channel, i0);

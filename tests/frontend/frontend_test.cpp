@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "config.hpp"
 #include "synthetic_scans.hpp"
@@ -154,6 +155,11 @@ struct SparseRun {
   int min_voting = 1 << 20;  // fewest ensemble members voting on a step (after the first scan)
   // Map memory the frontend reports over its own map's: the members' maps count too.
   double map_bytes_over_own = 0.0;
+  // The results with a pose, in the order they came (process(), then finish()), and how many
+  // calls gave none yet (kHeld).
+  std::vector<FrontendResult> results;
+  int held = 0;
+  FrontendCounters counters;
 };
 // Pose k of a sparse log in the room (scans 3 s apart).
 Pose2 sparse_truth(int k) {
@@ -163,7 +169,8 @@ Pose2 sparse_truth(int k) {
   return Pose2(2.2 * std::cos(phi), 1.8 * std::sin(phi), phi + M_PI / 2 + look);
 }
 
-// Sparse scans (`times_us[k]`, poses sparse_truth(pose_index[k])) through the frontend.
+// Sparse scans (`times_us[k]`, poses sparse_truth(pose_index[k])) through the frontend. Results
+// are taken by their time: with the lag (MatcherConfig::sparse_lag) they come a scan late.
 SparseRun run_sparse(const FrontendConfig& config, const std::vector<int64_t>& times_us,
                      const std::vector<int>& pose_index) {
   const auto world = synthetic::room();
@@ -176,16 +183,15 @@ SparseRun run_sparse(const FrontendConfig& config, const std::vector<int64_t>& t
   Frontend frontend(config);
   std::mt19937 rng(7);
   SparseRun run;
+  std::map<int64_t, Pose2> truth;  // by the scan's time
   Pose2 T_map_world;
-  for (std::size_t k = 0; k < times_us.size(); ++k) {
-    spec.utime_first = times_us[k];
-    const Pose2 T = sparse_truth(pose_index[k]);
-    const Scan scan = synthetic::make_sweep(
-        world, [&](int64_t) { return T; }, Pose2(), spec, &rng);
-    const FrontendResult r = frontend.process(scan);
+  auto take = [&](const FrontendResult& r) {
+    if (!r.has_pose()) return;
     if (r.status == ScanStatus::kMatched) ++run.matched;
-    if (k > 0) run.min_voting = std::min(run.min_voting, r.ensemble_voting);
-    if (k == 0) T_map_world = T.inverse();
+    if (!run.results.empty()) run.min_voting = std::min(run.min_voting, r.ensemble_voting);
+    const Pose2 T = truth.at(r.utime);
+    if (run.results.empty()) T_map_world = T.inverse();
+    run.results.push_back(r);
     const Pose2 T_map_base_true = T_map_world * T;
     run.max_position_error_m =
         std::max(run.max_position_error_m,
@@ -193,9 +199,21 @@ SparseRun run_sparse(const FrontendConfig& config, const std::vector<int64_t>& t
     run.max_heading_error_rad =
         std::max(run.max_heading_error_rad,
                  std::abs(wrap_angle(r.T_map_base.theta() - T_map_base_true.theta())));
+  };
+  for (std::size_t k = 0; k < times_us.size(); ++k) {
+    spec.utime_first = times_us[k];
+    const Pose2 T = sparse_truth(pose_index[k]);
+    const Scan scan = synthetic::make_sweep(
+        world, [&](int64_t) { return T; }, Pose2(), spec, &rng);
+    truth[scan.utime_last] = T;
+    const FrontendResult r = frontend.process(scan);
+    if (r.status == ScanStatus::kHeld) ++run.held;
+    take(r);
   }
+  if (const auto r = frontend.finish()) take(*r);
   run.map_bytes_over_own = static_cast<double>(frontend.map_memory_bytes()) /
                            static_cast<double>(frontend.map().memory_bytes());
+  run.counters = frontend.counters();
   return run;
 }
 
@@ -226,6 +244,30 @@ TEST(Frontend, TracksSparseScansWithLargeTurns) {
   config.matcher.wide_search_gap_us = 10'000'000;
   const SparseRun off = run_sparse(config);
   EXPECT_GT(off.max_position_error_m, 0.3);
+}
+
+TEST(Frontend, LogSubsampledByTravelRunsOneScanBehindWithTheSamePoses) {
+  FrontendConfig config;
+  load_config("configs/frontend.yaml", config);
+  ASSERT_TRUE(config.matcher.sparse_lag);
+  const SparseRun lag = run_sparse(config);
+  config.matcher.sparse_lag = false;
+  const SparseRun off = run_sparse(config);
+  // The stream is known to be subsampled by travel once five intervals are seen: from the
+  // seventh scan on, each result is the scan before's, and finish() gives the last.
+  EXPECT_EQ(lag.held, 1);
+  EXPECT_EQ(off.held, 0);
+  ASSERT_EQ(lag.results.size(), 18u);
+  ASSERT_EQ(off.results.size(), 18u);
+  // Where no scan fits better near the pose halfway between its neighbours (nothing to revise
+  // here), the lag moves no pose: a scan's map update is undone and redone exactly when it is
+  // compared without it.
+  EXPECT_EQ(lag.counters.scans_revised, 0);
+  for (std::size_t k = 0; k < 18; ++k) {
+    EXPECT_EQ(lag.results[k].utime, off.results[k].utime) << k;
+    EXPECT_EQ(lag.results[k].T_map_base.vector(), off.results[k].T_map_base.vector()) << k;
+    EXPECT_EQ(lag.results[k].ensemble_voting, config.matcher.sparse_ensemble_members) << k;
+  }
 }
 
 TEST(Frontend, ScanOfASparseLogStampedJustAfterTheLastIsStillMatchedAsSparse) {
@@ -350,6 +392,11 @@ TEST(Frontend, ShippedConfigLoadsAndIsUsable) {
   const auto start_problem = config_problem(nan_start);
   ASSERT_NE(start_problem, std::nullopt);
   EXPECT_NE(start_problem->find("initial_pose"), std::string::npos) << *start_problem;
+  FrontendConfig no_lag_window = config;
+  no_lag_window.matcher.sparse_lag_window_m = 0.0;
+  const auto lag_problem = config_problem(no_lag_window);
+  ASSERT_NE(lag_problem, std::nullopt);
+  EXPECT_NE(lag_problem->find("matcher.sparse_lag_window_m"), std::string::npos) << *lag_problem;
   config.map.levels = 0;
   EXPECT_NE(config_problem(config), std::nullopt);
 }

@@ -25,6 +25,49 @@ OccupancyGrid room_grid(double resolution) {
   return grid;
 }
 
+// Every cell's probability within +-`half` cells of the origin.
+std::vector<double> cells(const OccupancyGrid& grid, int half) {
+  std::vector<double> v;
+  for (int j = -half; j <= half; ++j)
+    for (int i = -half; i <= half; ++i) v.push_back(grid.cell_probability(i, j));
+  return v;
+}
+
+TEST(OccupancyGrid, JournalRollbackUndoesUpdatesExactlyAndEndKeepsThem) {
+  OccupancyGrid grid = room_grid(0.05);
+  // Hits at the same cells over and over saturate their log-odds (clamped): no opposite update
+  // could undo the last ones. Far hits create tiles that did not exist.
+  std::vector<Eigen::Vector2d> hits{{1.0, 0.3}, {-0.7, 1.2}, {12.0, -9.0}};
+  const std::vector<double> before = cells(grid, 300);
+  const std::size_t tiles_before = grid.tile_count();
+  const std::size_t tile_bytes = grid.memory_bytes() / tiles_before;
+  grid.begin_journal();
+  for (int k = 0; k < 200; ++k) grid.update({0.1, 0.2}, hits);
+  ASSERT_NE(cells(grid, 300), before);
+  ASSERT_GT(grid.tile_count(), tiles_before);
+  // The saved tiles count in the memory reported while the journal is open.
+  EXPECT_GT(grid.memory_bytes(), grid.tile_count() * tile_bytes);
+  grid.rollback();
+  EXPECT_EQ(grid.memory_bytes(), tiles_before * tile_bytes);
+  EXPECT_FALSE(grid.journal_open());
+  EXPECT_EQ(cells(grid, 300), before);
+  EXPECT_EQ(grid.tile_count(), tiles_before);
+  // Reads between the update and the rollback (a matcher's) do not hide a tile from the journal.
+  grid.begin_journal();
+  EXPECT_NEAR(grid.cell_probability(20, 6), 0.5, 0.5);
+  grid.update({0.1, 0.2}, hits);
+  const std::vector<double> after_one = cells(grid, 300);
+  grid.rollback();
+  EXPECT_EQ(cells(grid, 300), before);
+  // Kept: the update stays, and a later rollback has nothing to undo.
+  grid.begin_journal();
+  grid.update({0.1, 0.2}, hits);
+  grid.end_journal();
+  EXPECT_EQ(cells(grid, 300), after_one);
+  grid.rollback();
+  EXPECT_EQ(cells(grid, 300), after_one);
+}
+
 TEST(OccupancyGrid, UnobservedIsHalfAndHitsAreOccupiedRaysFree) {
   OccupancyGrid grid(0.05, 0.9, 0.4);
   EXPECT_DOUBLE_EQ(grid.value({1.0, 2.0}), 0.5);

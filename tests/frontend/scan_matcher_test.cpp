@@ -166,6 +166,32 @@ TEST(ScanMatcher, StepPriorMovesStalledStepForwardOnlyWhereScanCannotTell) {
   EXPECT_LT(std::abs(wrap_angle(in_room.T_map_base.theta() - truth.theta())), 0.02);
 }
 
+// The pieces the sparse lag scores a pose with: the search's own score of one pose, and the step
+// prior's cost of one step.
+TEST(ScanMatcher, PoseEvidenceAndStepPriorCostAreTheSearchsTermsForOnePose) {
+  const auto world = synthetic::room();
+  const MapPyramid maps = build_map(world, {kMapPose, Pose2(-1.5, 1.0, 0.0)});
+  const std::vector<Eigen::Vector2d> points = static_scan(world, Pose2(0.5, 0.4, 0.3), 360, 0.005);
+  for (const Pose2& T : {Pose2(0.5, 0.4, 0.3), Pose2(0.8, 0.1, 0.5), Pose2(-1.0, 2.0, -2.0)}) {
+    EXPECT_NEAR(pose_evidence(maps.level(1), points, T),
+                wide_search(maps.level(1), points, T, 0.0, 0.0).score, 1e-5);
+  }
+  EXPECT_GT(pose_evidence(maps.level(1), points, Pose2(0.5, 0.4, 0.3)), 0.8);
+  EXPECT_LT(pose_evidence(maps.level(1), points, Pose2(0.8, 0.1, 0.5)), 0.5);
+
+  const Pose2 last(1.0, 2.0, 0.5);
+  const StepPrior prior = step_prior(MatcherConfig{}, last);  // 0.8 m, 0.4 rad; 0.2, 0.1 per point
+  EXPECT_NEAR(step_prior_cost(prior, last), 0.2, 1e-12);  // standing still: the whole short weight
+  EXPECT_NEAR(step_prior_cost(prior, last * Pose2(0.4, 0.0, 0.0)), 0.2 * 0.25, 1e-12);
+  EXPECT_NEAR(step_prior_cost(prior, last * Pose2(1.0, 0.0, 0.0)), 0.0, 1e-12);
+  // On the arc through a turn of 0.6 rad: no cost; 0.8 m off it sideways, or 0.8 m backwards:
+  // 0.1 ((0.8 - 0.2) / 0.3)^2.
+  EXPECT_NEAR(step_prior_cost(prior, last * Pose2(1.0, std::tan(0.3), 0.6)), 0.0, 1e-12);
+  EXPECT_NEAR(step_prior_cost(prior, last * Pose2(1.0, 0.8, 0.0)), 0.1 * 4.0, 1e-12);
+  EXPECT_NEAR(step_prior_cost(prior, last * Pose2(-0.8, 0.0, 0.0)), 0.1 * 4.0, 1e-12);
+  EXPECT_EQ(step_prior_cost(StepPrior{}, last), 0.0);  // no prior
+}
+
 // The whole pyramid, coarse to fine, converges from further away than any single fine level.
 TEST(ScanMatcher, PyramidConvergesFromLargeOffset) {
   const auto world = synthetic::room();
