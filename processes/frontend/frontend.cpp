@@ -25,10 +25,6 @@ constexpr double kAgreeM = 0.15, kAgreeRad = 0.05;
 // This many scans in a row that are not sparse make a scanner's stream: the ensemble is dropped
 // (on the CARMEN logs every scan after the first is sparse; a stream pays for three scans).
 constexpr int kDenseScansEndingEnsemble = 3;
-// Sparse lag: a step longer than this many times the 90th percentile of the last settled steps
-// is long for the log; it loses sparse_lag_long_weight per point at this much beyond.
-constexpr double kLongStepFactor = 1.25;
-constexpr double kLongStepScaleM = 0.3;
 
 // Offset of ensemble member k (1, 2, ...) from the initial pose: fractions of a cell of
 // `cell_m` in x and y and up to a degree of heading, from an additive recurrence of irrational
@@ -46,19 +42,19 @@ Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
       .toRotationMatrix();
 }
 
-bool agrees(const Pose2& a, const Pose2& b) {
+}  // namespace
+
+bool poses_agree(const Pose2& a, const Pose2& b) {
   return (a.translation() - b.translation()).norm() < kAgreeM &&
          std::abs(wrap_angle(a.theta() - b.theta())) < kAgreeRad;
 }
-
-}  // namespace
 
 StepVote vote_on_steps(const std::vector<Pose2>& steps, const Eigen::Matrix2d& R_map_last) {
   StepVote v;
   if (steps.empty()) return v;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     int support = 0;
-    for (const Pose2& other : steps) support += agrees(steps[i], other) ? 1 : 0;
+    for (const Pose2& other : steps) support += poses_agree(steps[i], other) ? 1 : 0;
     if (support > v.support) {
       v.support = support;
       v.chosen = i;
@@ -234,18 +230,16 @@ void Frontend::update_motion(const Pose2& T_map_base, int64_t utime, bool sparse
     }
   }
   if (initialised_) {
-    recent_intervals_us_[interval_count_ % recent_intervals_us_.size()] = utime - last_utime_;
-    ++interval_count_;
+    recent_intervals_us_.add(static_cast<double>(utime - last_utime_));
   }
   T_map_base_last_ = T_map_base;
   last_utime_ = utime;
 }
 
 bool Frontend::subsampled_by_travel() const {
-  if (interval_count_ < kRecentIntervals) return false;
-  std::array<int64_t, kRecentIntervals> sorted = recent_intervals_us_;
-  std::nth_element(sorted.begin(), sorted.begin() + kRecentIntervals / 2, sorted.end());
-  return sorted[kRecentIntervals / 2] > config_.matcher.wide_search_gap_us;
+  return recent_intervals_us_.size() == kRecentIntervals &&
+         recent_intervals_us_.percentile(50) >
+             static_cast<double>(config_.matcher.wide_search_gap_us);
 }
 
 void Frontend::take_prediction(FrontendResult& result, const Pose2& T_pred, bool sparse_scan) {
@@ -320,7 +314,7 @@ void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& m
       T_published_last_ * between(last[voters[v.chosen]], c.T_map_base_predicted);
 
   if (v.support < static_cast<int>(steps.size())) ++counters_.steps_disputed;
-  if (!agrees(steps[0], step)) ++counters_.steps_outvoted;
+  if (!poses_agree(steps[0], step)) ++counters_.steps_outvoted;
   result.T_map_base = published;
   result.T_map_base_predicted = predicted;
   result.covariance = covariance;
@@ -430,152 +424,6 @@ void Frontend::add_to_map(FrontendResult& result, const std::vector<Eigen::Vecto
       result.T_map_base.translation(), static_cast<std::size_t>(config_.map.max_bytes)));
   ++counters_.map_updates;
   result.map_updated = true;
-}
-
-FrontendResult Frontend::process_own(const Scan& scan) {
-  bool by_travel = false;
-  FrontendResult result = measure(scan, by_travel);
-  if (result.status == ScanStatus::kDropped) return result;
-  const bool matched = result.status == ScanStatus::kMatched;
-  lagging_ = lagging_ || (by_travel && config_.matcher.sparse_lag);
-  if (!lagging_) {
-    if (matched) add_to_map(result, points_buffer_);
-    T_emitted_last_ = result.T_map_base;
-    return result;
-  }
-  // One scan behind: the held scan is settled with this one's pose, then this one is held, its
-  // map update journaled so that settling can move it.
-  FrontendResult out;
-  out.status = ScanStatus::kHeld;
-  out.utime = result.utime;
-  if (held_) {
-    const int64_t revised = counters_.scans_revised;
-    out = settle(*held_, &result);
-    if (matched && counters_.scans_revised > revised) {
-      // This scan was matched against the held one where it no longer is: again, from its pose.
-      const MatchResult m = match_scan_wide(map_, matched_buffer_, {result.T_map_base},
-                                            config_.matcher, &out.T_map_base);
-      result.T_map_base = m.T_map_base;
-      result.covariance = m.covariance;
-      result.matched_points = m.points;
-      result.iterations += m.iterations;
-      result.residual_rms = m.residual_rms;
-      T_map_base_last_ = m.T_map_base;
-      covariance_last_ = m.covariance;
-    }
-  }
-  Held next{result, {}, {}, T_emitted_last_, T_map_base_last_update_};
-  if (matched) {
-    next.points = points_buffer_;
-    next.points_matched = matched_buffer_;
-    map_.begin_journal();
-    add_to_map(next.result, next.points);
-  }
-  held_ = std::move(next);
-  return out;
-}
-
-double Frontend::lag_score(const Held& held, const Pose2& T, const Pose2& T_next) const {
-  const int level = std::min(1, map_.levels() - 1);
-  const double evidence = pose_evidence(map_.level(level), held.points_matched, T);
-  double cost = step_prior_cost(step_prior(config_.matcher, held.T_before), T) +
-                step_prior_cost(step_prior(config_.matcher, T), T_next);
-  // A step longer than the log's steps usually are (kLongStepFactor times the 90th percentile
-  // of the last settled ones) loses sparse_lag_long_weight per point at kLongStepScaleM beyond.
-  const std::size_t n = std::min(step_count_, kRecentSteps);
-  if (n >= kRecentSteps / 2) {
-    std::vector<double> lengths(recent_steps_m_.begin(), recent_steps_m_.begin() + n);
-    const std::size_t k90 = n * 9 / 10;
-    std::nth_element(lengths.begin(), lengths.begin() + k90, lengths.end());
-    const double limit = kLongStepFactor * lengths[k90];
-    for (const double length : {between(held.T_before, T).translation().norm(),
-                                between(T, T_next).translation().norm()}) {
-      const double e = std::max(0.0, length - limit) / kLongStepScaleM;
-      cost += config_.matcher.sparse_lag_long_weight * e * e;
-    }
-  }
-  return evidence - cost;
-}
-
-FrontendResult Frontend::settle(Held& held, const FrontendResult* next) {
-  FrontendResult& r = held.result;
-  if (r.status == ScanStatus::kMatched && r.sparse && next != nullptr &&
-      next->status == ScanStatus::kMatched && next->sparse) {
-    // Where the scan fits best may not be where it was (a room mapped differently on an earlier
-    // pass): the pose halfway between the steps around it is a second candidate, matched in a
-    // narrow window, and the better of the two by the lag's score is kept.
-    const Pose2 mid =
-        held.T_before * Pose2::exp(0.5 * between(held.T_before, next->T_map_base).log());
-    const Pose2 d = between(mid, r.T_map_base);
-    if (d.translation().norm() > config_.matcher.sparse_lag_window_m ||
-        std::abs(d.theta()) > config_.matcher.sparse_lag_window_rad) {
-      // Compared in the map without the scan itself.
-      map_.rollback();
-      if (r.map_updated) {
-        T_map_base_last_update_ = held.T_last_update_before;
-        --counters_.map_updates;
-        r.map_updated = false;
-      }
-      MatcherConfig narrow = config_.matcher;
-      narrow.wide_search_linear_window_m = config_.matcher.sparse_lag_window_m;
-      narrow.wide_search_angular_window_rad = config_.matcher.sparse_lag_window_rad;
-      const MatchResult alt =
-          match_scan_wide(map_, held.points_matched, {mid}, narrow, &held.T_before);
-      const double own = lag_score(held, r.T_map_base, next->T_map_base);
-      const double other = lag_score(held, alt.T_map_base, next->T_map_base);
-      if (!agrees(alt.T_map_base, r.T_map_base)) {
-        const Pose2 T_own = r.T_map_base;
-        const bool revise = other > own + config_.matcher.sparse_lag_margin;
-        if (revise) {
-          ++counters_.scans_revised;
-          r.T_map_base = alt.T_map_base;
-          r.covariance = alt.covariance;
-          r.matched_points = alt.points;
-          r.residual_rms = alt.residual_rms;
-        }
-        // The candidate not taken is a second place the pose may be: its offset joins the
-        // covariance with the weight the wide search's spread would give it (its score, summed
-        // over the points, below the other's, in temperatures).
-        const double temperature = config_.matcher.wide_search_temperature;
-        if (temperature > 0.0) {
-          const double gap =
-              std::abs(own - other) * static_cast<double>(held.points_matched.size()) / temperature;
-          const Pose2& T_other = revise ? T_own : alt.T_map_base;
-          Eigen::Vector3d offset;
-          offset.head<2>() = T_other.translation() - r.T_map_base.translation();
-          offset.z() = wrap_angle(T_other.theta() - r.T_map_base.theta());
-          r.covariance += offset * offset.transpose() / (1.0 + std::exp(gap));
-        }
-      }
-      add_to_map(r, held.points);
-    }
-  }
-  map_.end_journal();
-  recent_steps_m_[step_count_ % kRecentSteps] =
-      between(held.T_before, r.T_map_base).translation().norm();
-  ++step_count_;
-  T_emitted_last_ = r.T_map_base;
-  return r;
-}
-
-std::optional<FrontendResult> Frontend::finish_own() {
-  if (!held_) return std::nullopt;
-  FrontendResult r = settle(*held_, nullptr);
-  held_.reset();
-  return r;
-}
-
-std::optional<FrontendResult> Frontend::finish() {
-  std::vector<Pose2> last{T_emitted_last_};
-  for (const auto& m : members_) last.push_back(m->T_emitted_last_);
-  std::optional<FrontendResult> result = finish_own();
-  std::vector<FrontendResult> member_results;
-  for (auto& m : members_) {
-    const std::optional<FrontendResult> r = m->finish_own();
-    member_results.push_back(r ? *r : FrontendResult{});
-  }
-  if (result && !members_.empty()) vote(*result, member_results, last);
-  return result;
 }
 
 }  // namespace traverse::frontend

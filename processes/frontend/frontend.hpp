@@ -23,6 +23,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -96,6 +97,28 @@ struct StepVote {
   Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
 };
 StepVote vote_on_steps(const std::vector<Pose2>& steps, const Eigen::Matrix2d& R_map_last);
+// Whether two steps (or poses) agree: within 0.15 m and 0.05 rad.
+bool poses_agree(const Pose2& a, const Pose2& b);
+
+// The last N values of a stream (a ring): how many are held, and their percentiles.
+template <std::size_t N>
+class RecentValues {
+ public:
+  void add(double value) { values_[count_++ % N] = value; }
+  std::size_t size() const { return std::min(count_, N); }
+  // The (size() * percent / 100)-th smallest of those held, counting from 0; size() > 0.
+  double percentile(std::size_t percent) const {
+    std::array<double, N> v = values_;
+    const std::size_t n = size(), k = std::min(n - 1, n * percent / 100);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k),
+                     v.begin() + static_cast<std::ptrdiff_t>(n));
+    return v[k];
+  }
+
+ private:
+  std::array<double, N> values_{};
+  std::size_t count_ = 0;
+};
 
 class Frontend {
  public:
@@ -184,19 +207,17 @@ class Frontend {
   Eigen::Vector3d sparse_step_ = Eigen::Vector3d::Zero();
   bool have_sparse_step_ = false;
   Eigen::Matrix3d covariance_last_ = Eigen::Matrix3d::Zero();
-  // The intervals between the last kRecentIntervals poses [us] (a ring), and how many were seen.
+  // The intervals between the last kRecentIntervals poses [us].
   static constexpr std::size_t kRecentIntervals = 5;
-  std::array<int64_t, kRecentIntervals> recent_intervals_us_{};
-  std::size_t interval_count_ = 0;
+  RecentValues<kRecentIntervals> recent_intervals_us_;
 
   // Sparse lag: whether this stream runs one scan behind, the scan held, the pose last emitted
-  // (own map frame), and the lengths of the last settled steps [m] (a ring, how many were seen).
+  // (own map frame), and the lengths of the last settled steps [m].
   bool lagging_ = false;
   std::optional<Held> held_;
   Pose2 T_emitted_last_;
   static constexpr std::size_t kRecentSteps = 30;
-  std::array<double, kRecentSteps> recent_steps_m_{};
-  std::size_t step_count_ = 0;
+  RecentValues<kRecentSteps> recent_steps_m_;
 
   // Sparse-scan ensemble: the other members (each a frontend of one, its grid offset); the last
   // published pose; how many scans in a row were not sparse (three drop the members: a scanner's
