@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 
 #include "deskew.hpp"
 
@@ -271,20 +272,40 @@ bool Frontend::map_update_due(const Pose2& T_map_base) const {
          std::abs(d.theta()) >= config_.map.update_angle_rad;
 }
 
-FrontendResult Frontend::process(const Scan& scan) {
-  if (config_.matcher.sparse_ensemble_members <= 1) return process_own(scan);
+FrontendResult Frontend::run_and_vote(const std::function<FrontendResult(Frontend&)>& own) {
+  if (config_.matcher.sparse_ensemble_members <= 1) return own(*this);
   // The pose each frontend last gave: the step of its result is from there.
   std::vector<Pose2> last{T_emitted_last_};
   for (const auto& m : members_) last.push_back(m->T_emitted_last_);
-  FrontendResult result = process_own(scan);
+  FrontendResult result = own(*this);
   std::vector<FrontendResult> member_results;
   member_results.reserve(members_.size());
-  for (auto& m : members_) member_results.push_back(m->process(scan));
-  if (!result.has_pose()) return result;
-  vote(result, member_results, last);
+  for (auto& m : members_) member_results.push_back(own(*m));
+  if (result.has_pose()) vote(result, member_results, last);
+  return result;
+}
+
+FrontendResult Frontend::process(const Scan& scan) {
+  const FrontendResult result = run_and_vote([&](Frontend& f) { return f.process_own(scan); });
+  if (config_.matcher.sparse_ensemble_members <= 1 || !result.has_pose()) return result;
   dense_in_a_row_ = result.sparse ? 0 : dense_in_a_row_ + 1;
   if (dense_in_a_row_ >= kDenseScansEndingEnsemble) members_.clear();
   return result;
+}
+
+std::optional<FrontendResult> Frontend::finish() {
+  const FrontendResult result = run_and_vote([](Frontend& f) { return f.finish_own(); });
+  if (!result.has_pose()) return std::nullopt;
+  return result;
+}
+
+void Frontend::take_match(FrontendResult& result, const MatchResult& m) {
+  result.T_map_base = m.T_map_base;
+  result.covariance = m.covariance;
+  result.matched_points = m.points;
+  result.iterations += m.iterations;
+  result.residual_rms = m.residual_rms;
+  result.searched = result.searched || m.searched;
 }
 
 void Frontend::vote(FrontendResult& result, const std::vector<FrontendResult>& member_results,
@@ -402,12 +423,7 @@ FrontendResult Frontend::measure(const Scan& scan, bool& by_travel_out) {
       result.status = ScanStatus::kPredicted;
       return result;
     }
-    result.T_map_base = m.T_map_base;
-    result.covariance = m.covariance;
-    result.matched_points = m.points;
-    result.iterations = m.iterations;
-    result.residual_rms = m.residual_rms;
-    result.searched = m.searched;
+    take_match(result, m);
   }
   ++counters_.scans_matched;
   covariance_last_ = result.covariance;

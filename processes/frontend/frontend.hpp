@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -166,8 +167,13 @@ class Frontend {
   // The lag's score of the held scan at T (see MatcherConfig::sparse_lag): mean evidence per
   // point minus the step priors of the steps into T and from T to the next scan's pose.
   double lag_score(const Held& held, const Pose2& T, const Pose2& T_next) const;
-  // Finishes this frontend's own held scan, if any.
-  std::optional<FrontendResult> finish_own();
+  // Finishes this frontend's own held scan (status kDropped: none held).
+  FrontendResult finish_own();
+  // Runs `own` (one frontend's step: process_own, finish_own) on this frontend and each member of
+  // the ensemble, and, with an ensemble configured, votes on the result.
+  FrontendResult run_and_vote(const std::function<FrontendResult(Frontend&)>& own);
+  // Gives `result` the pose of a match and its figures (iterations add up).
+  static void take_match(FrontendResult& result, const MatchResult& m);
   // Votes on the step from the last pose (`last`: the one this frontend, then each member, last
   // gave before this result) among this frontend and the ensemble's members; `result` (this
   // frontend's own) becomes the published pose.

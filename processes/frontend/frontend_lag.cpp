@@ -39,11 +39,7 @@ FrontendResult Frontend::process_own(const Scan& scan) {
       // This scan was matched against the held one where it no longer is: again, from its pose.
       const MatchResult m = match_scan_wide(map_, matched_buffer_, {result.T_map_base},
                                             config_.matcher, &out.T_map_base);
-      result.T_map_base = m.T_map_base;
-      result.covariance = m.covariance;
-      result.matched_points = m.points;
-      result.iterations += m.iterations;
-      result.residual_rms = m.residual_rms;
+      take_match(result, m);
       T_map_base_last_ = m.T_map_base;
       covariance_last_ = m.covariance;
     }
@@ -108,10 +104,7 @@ FrontendResult Frontend::settle(Held& held, const FrontendResult* next) {
         const bool revise = other > own + config_.matcher.sparse_lag_margin;
         if (revise) {
           ++counters_.scans_revised;
-          r.T_map_base = alt.T_map_base;
-          r.covariance = alt.covariance;
-          r.matched_points = alt.points;
-          r.residual_rms = alt.residual_rms;
+          take_match(r, alt);
         }
         // The candidate not taken is a second place the pose may be: its offset joins the
         // covariance with the weight the wide search's spread would give it (its score, summed
@@ -136,24 +129,11 @@ FrontendResult Frontend::settle(Held& held, const FrontendResult* next) {
   return r;
 }
 
-std::optional<FrontendResult> Frontend::finish_own() {
-  if (!held_) return std::nullopt;
+FrontendResult Frontend::finish_own() {
+  if (!held_) return {};
   FrontendResult r = settle(*held_, nullptr);
   held_.reset();
   return r;
-}
-
-std::optional<FrontendResult> Frontend::finish() {
-  std::vector<Pose2> last{T_emitted_last_};
-  for (const auto& m : members_) last.push_back(m->T_emitted_last_);
-  std::optional<FrontendResult> result = finish_own();
-  std::vector<FrontendResult> member_results;
-  for (auto& m : members_) {
-    const std::optional<FrontendResult> r = m->finish_own();
-    member_results.push_back(r ? *r : FrontendResult{});
-  }
-  if (result && !members_.empty()) vote(*result, member_results, last);
-  return result;
 }
 
 }  // namespace traverse::frontend

@@ -32,6 +32,19 @@ double step_shape_cost(const StepPrior& sp, double length, double forward, doubl
   const double e_back = std::max(0.0, -forward - sp.off_arc_free_m) / kOffArcScaleM;
   return cost + sp.off_arc_weight * (e_side * e_side + e_back * e_back);
 }
+// Evidence 2 (p - 0.5) of a cell of occupancy probability p.
+float cell_evidence(double p) { return static_cast<float>(2.0 * (p - 0.5)); }
+
+// The search's evidence of a cell, blurred: its own, or half that of its most occupied neighbour
+// if that is larger (free space is not spread). `at(di, dj)`: the evidence of the cell (di, dj)
+// away, di and dj in -1..1.
+template <class At>
+float blurred_evidence(At at) {
+  float m = 0.0f;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) m = std::max(m, at(di, dj));
+  return m > 0.0f ? std::max(at(0, 0), 0.5f * m) : at(0, 0);
+}
 }  // namespace
 
 double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
@@ -42,12 +55,8 @@ double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2
   for (const auto& p : points_base) {
     const Eigen::Vector2d q = T_map_base * p;
     const int64_t i = std::llround(q.x() / res), j = std::llround(q.y() / res);
-    const double own = 2.0 * (grid.cell_probability(i, j) - 0.5);
-    double m = 0.0;  // as the search's table: blurred by half the occupied neighbours
-    for (int64_t dj = -1; dj <= 1; ++dj)
-      for (int64_t di = -1; di <= 1; ++di)
-        m = std::max(m, 2.0 * (grid.cell_probability(i + di, j + dj) - 0.5));
-    sum += m > 0.0 ? std::max(own, 0.5 * m) : own;
+    sum += blurred_evidence(
+        [&](int di, int dj) { return cell_evidence(grid.cell_probability(i + di, j + dj)); });
   }
   return sum / static_cast<double>(points_base.size());
 }
@@ -101,16 +110,14 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
   for (int j = 0; j < side; ++j) {
     for (int i = 0; i < side; ++i) {
       const double p = grid.cell_probability(cx - half + i, cy - half + j);
-      evidence[at(i, j)] = static_cast<float>(2.0 * (p - 0.5));
+      evidence[at(i, j)] = cell_evidence(p);
     }
   }
   std::vector<float> table(evidence.size(), 0.0f);
   for (int j = 1; j + 1 < side; ++j) {
     for (int i = 1; i + 1 < side; ++i) {
-      float m = 0.0f;  // occupied neighbours only: free space is not spread
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int di = -1; di <= 1; ++di) m = std::max(m, evidence[at(i + di, j + dj)]);
-      table[at(i, j)] = m > 0.0f ? std::max(evidence[at(i, j)], 0.5f * m) : evidence[at(i, j)];
+      table[at(i, j)] =
+          blurred_evidence([&](int di, int dj) { return evidence[at(i + di, j + dj)]; });
     }
   }
   // bound(i, j) = max of table over [i, i + kBlock) x [j, j + kBlock), separably.
