@@ -8,6 +8,7 @@ namespace traverse::channels {
 inline const std::string kScanHorizontal = "SCAN_HORIZONTAL";  // planar_scan_t, horizontal scanner
 inline const std::string kScanProfile = "SCAN_PROFILE";        // planar_scan_t, tilted scanner
 inline const std::string kImu = "IMU";                         // imu_t
+inline const std::string kOdometry = "ODOMETRY";              // odometry_t, wheel encoders
 inline const std::string kPoseGroundTruth = "POSE_GROUND_TRUTH";  // pose2d_t, simulator truth
 inline const std::string kPoseReference = "POSE_REFERENCE";    // pose2d_t, external reference
 inline const std::string kPoseFrontend = "POSE_FRONTEND";      // pose2d_t, one per scan
