@@ -16,6 +16,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -84,6 +87,11 @@ class Reader {
       } catch (const YAML::Exception&) {
         fail(path, expected_name<T>(), n);
       }
+      // .inf and .nan are valid YAML numbers, but no setting means them: a range check of the
+      // form "at least x" would let them through.
+      if constexpr (std::is_floating_point_v<T>) {
+        if (!std::isfinite(value)) fail(path, expected_name<T>(), n);
+      }
     }
   }
 
@@ -91,7 +99,7 @@ class Reader {
   static const char* expected_name() {
     if constexpr (std::is_same_v<T, bool>) return "true or false";
     else if constexpr (std::is_integral_v<T>) return "an integer";
-    else if constexpr (std::is_floating_point_v<T>) return "a number";
+    else if constexpr (std::is_floating_point_v<T>) return "a finite number";
     else return "a string";
   }
 
@@ -108,6 +116,71 @@ YAML::Node load_file(const std::string& path);
 YAML::Node load_string(const std::string& text, const std::string& name);
 
 }  // namespace config_detail
+
+// Checks the values of a loaded config, naming each bad one by its key path. A stage's
+// `validate(const XConfig&)` runs the checks of its struct (and of nested structs, with
+// `nested("key")`) and returns `problem()`; the process start turns a problem into a ConfigError
+// naming the file, so every program refuses a config it cannot run with before it starts.
+//
+//   std::optional<std::string> validate(const MatcherConfig& c) {
+//     ConfigCheck check;
+//     check.positive("resolution_m", c.resolution_m);
+//     check.in_range("levels", c.levels, 1, 8);
+//     check.require(c.max_range_m > c.min_range_m, "max_range_m", "must exceed min_range_m");
+//     return check.problem();
+//   }
+class ConfigCheck {
+ public:
+  explicit ConfigCheck(std::string prefix = "") : prefix_(std::move(prefix)) {}
+
+  // `ok` or the key is reported with `what` ("must be positive").
+  void require(bool ok, const std::string& key, const std::string& what) {
+    if (!ok && !problem_) problem_ = "key '" + prefix_ + key + "' " + what;
+  }
+  template <class T>
+  void positive(const std::string& key, T value) {
+    require(value > T{0}, key, "must be positive, got " + show(value));
+  }
+  template <class T>
+  void not_negative(const std::string& key, T value) {
+    require(value >= T{0}, key, "must not be negative, got " + show(value));
+  }
+  template <class T>
+  void in_range(const std::string& key, T value, T lo, T hi) {
+    require(value >= lo && value <= hi, key,
+            "must be in [" + show(lo) + ", " + show(hi) + "], got " + show(value));
+  }
+  void not_empty(const std::string& key, const std::string& value) {
+    require(!value.empty(), key, "must not be empty");
+  }
+  // A nested struct's problem, its keys prefixed with `key.`.
+  void nested(const std::string& key, const std::optional<std::string>& nested_problem) {
+    if (nested_problem && !problem_) problem_ = insert_prefix(prefix_ + key + ".", *nested_problem);
+  }
+  // The first problem found, or nullopt when every check passed.
+  const std::optional<std::string>& problem() const { return problem_; }
+
+ private:
+  template <class T>
+  static std::string show(T value) {
+    if constexpr (std::is_floating_point_v<T>) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%g", static_cast<double>(value));
+      return buf;
+    } else {
+      return std::to_string(value);
+    }
+  }
+  // "key 'a' ..." becomes "key 'prefix.a' ...".
+  static std::string insert_prefix(const std::string& prefix, const std::string& problem) {
+    const std::string head = "key '";
+    if (problem.rfind(head, 0) == 0) return head + prefix + problem.substr(head.size());
+    return prefix + problem;
+  }
+
+  std::string prefix_;
+  std::optional<std::string> problem_;
+};
 
 // Loads `path` into `config`, throwing ConfigError (naming the key and the file) on any problem.
 template <class Config>

@@ -79,7 +79,7 @@ TEST(Config, MistypedValueNamesKey) {
   EXPECT_EQ(error_of("deskew: maybe\n"), "test.yaml: key 'deskew' expects true or false, got 'maybe'");
   EXPECT_EQ(error_of("grid: 3\n"), "test.yaml: key 'grid' expects a mapping of keys, got '3'");
   EXPECT_EQ(error_of("extrinsic: [1, a]\n"),
-            "test.yaml: key 'extrinsic[1]' expects a number, got 'a'");
+            "test.yaml: key 'extrinsic[1]' expects a finite number, got 'a'");
 }
 
 TEST(Config, TopLevelMustBeMapping) {
@@ -107,6 +107,46 @@ TEST(Config, BadYamlNamesFile) {
     EXPECT_NE(std::string(e.what()).find(path.string() + ": not valid YAML"), std::string::npos);
   }
   std::filesystem::remove(path);
+}
+
+TEST(Config, NonFiniteNumbersAreRefusedNamingKeyAndFile) {
+  for (const char* v : {".inf", "-.inf", ".nan", ".Inf", ".NaN"}) {
+    const std::string e = error_of(std::string("grid:\n  resolution_m: ") + v + "\n");
+    EXPECT_NE(e.find("test.yaml"), std::string::npos) << v;
+    EXPECT_NE(e.find("grid.resolution_m"), std::string::npos) << v;
+    EXPECT_NE(e.find("finite"), std::string::npos) << v;
+  }
+  const std::string list = error_of("extrinsic: [0, .nan, 0]\n");
+  EXPECT_NE(list.find("extrinsic[1]"), std::string::npos) << list;
+}
+
+std::optional<std::string> validate(const GridConfig& c) {
+  ConfigCheck check;
+  check.positive("resolution_m", c.resolution_m);
+  check.in_range("levels", c.levels, 1, 8);
+  return check.problem();
+}
+
+std::optional<std::string> validate(const NodeConfig& c) {
+  ConfigCheck check;
+  check.not_empty("frame", c.frame);
+  check.nested("grid", validate(c.grid));
+  check.require(c.extrinsic.size() == 3, "extrinsic", "must hold x, y, z");
+  return check.problem();
+}
+
+TEST(ConfigCheck, NamesTheFirstBadKeyWithItsPath) {
+  NodeConfig c;
+  EXPECT_FALSE(validate(c).has_value());
+  c.grid.resolution_m = 0.0;
+  c.grid.levels = 9;
+  ASSERT_TRUE(validate(c).has_value());
+  EXPECT_EQ(*validate(c), "key 'grid.resolution_m' must be positive, got 0");
+  c.grid.resolution_m = 0.1;
+  EXPECT_EQ(*validate(c), "key 'grid.levels' must be in [1, 8], got 9");
+  c.grid.levels = 2;
+  c.frame.clear();
+  EXPECT_EQ(*validate(c), "key 'frame' must not be empty");
 }
 
 }  // namespace
