@@ -12,14 +12,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The matcher's world-frame covariance of a pose, expressed in that pose's own frame (the frame of
-// the pose graph's edge error).
-Eigen::Matrix3d to_pose_frame(const Eigen::Matrix3d& covariance_world, const Pose2& T_world_pose) {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = T_world_pose.rotation().transpose();
-  return R * covariance_world * R.transpose();
-}
-
 }  // namespace
 
 std::string validate(const BackendConfig& c) {
@@ -180,7 +172,8 @@ void Backend::add_key_pose(const PlanarScan& scan) {
           T_world_key = r.T_world_query;
         }
       }
-      covariance = to_pose_frame(m.covariance, T_world_key);
+      // The matcher's covariance is in the world frame; the edge error's in the key pose's.
+      covariance = rotate_covariance(m.covariance, T_world_key.rotation().transpose());
     } else {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;

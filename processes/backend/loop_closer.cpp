@@ -96,9 +96,7 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   }
   // The matcher's covariance is in the world frame; the edge error's translation is in the frame
   // of the `to` pose.
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = T_world_current.rotation().transpose();
-  closure.covariance = R * covariance * R.transpose();
+  closure.covariance = rotate_covariance(covariance, T_world_current.rotation().transpose());
   closure.response = fine.raw_response;
   closure.second_peak = ambiguity;
   return closure;
