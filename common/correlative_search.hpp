@@ -46,7 +46,8 @@ class ScoreTable {
 
  private:
   static std::size_t size(int width, int height) {
-    return static_cast<std::size_t>(std::max(0, width)) * static_cast<std::size_t>(std::max(0, height));
+    return static_cast<std::size_t>(std::max(0, width)) *
+           static_cast<std::size_t>(std::max(0, height));
   }
   std::size_t index(int i, int j) const {
     return static_cast<std::size_t>(j) * static_cast<std::size_t>(width_) +
@@ -166,8 +167,8 @@ struct SearchResult {
 // the pose scored first: headings, then rows dy, then dx, in the order of their block's bound.
 template <class T, class Prior, class OnPose>
 SearchResult<T> branch_and_bound(const RotatedScans& scans, const ScoreTable& table,
-                                 const BlockBound& bound, int shifts, ScoredPose<T> start,
-                                 T margin, Prior prior, OnPose on_pose) {
+                                 const BlockBound& bound, int shifts, ScoredPose<T> start, T margin,
+                                 Prior prior, OnPose on_pose) {
   struct Block {
     T bound;
     int a, dx, dy;  // heading, lowest translation of the block [cells]

@@ -123,9 +123,8 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
   const auto no_visit = [](const correlative::ScoredPose<double>&, double) {};
 
   // Multi-resolution search (section IV), best-first until no block can beat the best.
-  const auto search = correlative::branch_and_bound<double>(scans, table.scores(), coarse, W,
-                                                            {-1.0, A, 0, 0}, 0.0, penalised,
-                                                            no_visit);
+  const auto search = correlative::branch_and_bound<double>(
+      scans, table.scores(), coarse, W, {-1.0, A, 0, 0}, 0.0, penalised, no_visit);
   result.evaluations = static_cast<long>(search.blocks + search.scored);
   const double best = search.best.score;
   const int best_a = search.best.a, best_i = search.best.dx, best_j = search.best.dy;
@@ -161,9 +160,8 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
       }
       return sum / n;
     };
-    const auto second = correlative::branch_and_bound<double>(scans, table.scores(), coarse, W,
-                                                              {0.0, A, 0, 0}, 0.0, far_raw,
-                                                              no_visit);
+    const auto second = correlative::branch_and_bound<double>(
+        scans, table.scores(), coarse, W, {0.0, A, 0, 0}, 0.0, far_raw, no_visit);
     result.evaluations += static_cast<long>(second.scored);
     result.second_peak_response = second.best.score;
   }

@@ -1,6 +1,6 @@
-// traverse-frontend: Hector-style scan-to-map matcher. Subscribes to planar scans and IMU samples,
-// publishes one pose per scan (map -> base) with its covariance (on a log subsampled by travel,
-// one scan late: matcher.sparse_lag).
+// traverse-frontend: the frontend (frontend.hpp; the Hector scan-to-map matcher as configured).
+// Subscribes to planar scans and IMU samples, publishes one pose per scan (map -> base) with its
+// covariance (on a log subsampled by travel, one scan late: matcher.sparse_lag).
 #include <spdlog/spdlog.h>
 
 #include "frontend_node.hpp"
@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
   traverse::frontend::FrontendConfig config;
   proc.offer_replay();
   if (auto rc = proc.start(argc, argv, config)) return *rc;
-  if (auto problem = traverse::frontend::config_problem(config)) {
+  if (auto problem = traverse::frontend::validate(config)) {
     spdlog::error("traverse-frontend: config error: {}: {}", proc.config_path(), *problem);
     return traverse::kConfigErrorExitCode;
   }
