@@ -20,7 +20,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -36,7 +35,8 @@ namespace traverse {
 // Wall-clock time in microseconds since the epoch.
 int64_t now_utime();
 
-// True once SIGINT or SIGTERM arrived (handlers installed by Process::start or install_stop_signals).
+// True once SIGINT or SIGTERM arrived (handlers installed by Process::start or
+// install_stop_signals).
 bool stop_requested();
 void install_stop_signals();
 
@@ -50,14 +50,20 @@ class Process {
   // Adds --replay and --record (see above): for processes of the graph that consume messages.
   void offer_replay();
 
-  // Parses arguments, loads the config file given by --config (if any) into `config`, and
-  // connects to LCM unless `connect` is false. Returns an exit code when the program must stop
-  // now (0 after --help, 2 for a bad command line or config, 1 when LCM cannot start).
+  // Parses arguments, loads the config file given by --config (if any) into `config`, checks it
+  // with the stage's `validate(const Config&)` (found by argument-dependent lookup; see
+  // ConfigCheck), and connects to LCM unless `connect` is false. Returns an exit code when the
+  // program must stop now (0 after --help, 2 for a bad command line or config, naming the key
+  // and the file, 1 when LCM cannot start).
   template <class Config>
   std::optional<int> start(int argc, char** argv, Config& config, bool connect = true) {
     if (auto rc = parse(argc, argv)) return rc;
     try {
       if (!config_path_.empty()) load_config(config_path_, config);
+      if (const std::optional<std::string> problem = config_detail::validate_stage(config)) {
+        throw ConfigError((config_path_.empty() ? "default config" : config_path_) + ": " +
+                          *problem);
+      }
     } catch (const ConfigError& e) {
       report_config_error(e);
       return kConfigErrorExitCode;
