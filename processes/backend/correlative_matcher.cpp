@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "config.hpp"
 #include "correlative_search.hpp"
 
 namespace traverse::backend {
@@ -68,19 +69,29 @@ class LookupTable {
 
 }  // namespace
 
-std::string validate(const CorrelativeMatcherConfig& c) {
-  if (!(c.resolution_m > 0.0)) return "resolution_m must be > 0";
-  if (c.coarse_factor < 1) return "coarse_factor must be >= 1";
-  if (!(c.angle_step_rad > 0.0)) return "angle_step_rad must be > 0";
-  if (c.linear_window_m < 0.0 || c.angular_window_rad < 0.0) return "windows must be >= 0";
-  if (!(c.kernel_sigma_m > 0.0)) return "kernel_sigma_m must be > 0";
-  if (!(c.penalty_sigma_xy_m > 0.0) || !(c.penalty_sigma_theta_rad > 0.0)) {
-    return "penalty sigmas must be > 0";
-  }
-  if (c.covariance_response_drop < 0.0) return "covariance_response_drop must be >= 0";
-  if (c.covariance_window_cells < 1) return "covariance_window_cells must be >= 1";
-  if (c.max_query_points < 1) return "max_query_points must be >= 1";
-  return {};
+std::optional<std::string> validate(const CorrelativeMatcherConfig& c) {
+  ConfigCheck check;
+  check.in_range("resolution_m", c.resolution_m, 0.001, 1.0);
+  check.in_range("coarse_factor", c.coarse_factor, 1, 64);
+  check.positive("angle_step_rad", c.angle_step_rad);
+  check.not_negative("linear_window_m", c.linear_window_m);
+  check.in_range("angular_window_rad", c.angular_window_rad, 0.0, M_PI);
+  check.positive("kernel_sigma_m", c.kernel_sigma_m);
+  check.positive("penalty_sigma_xy_m", c.penalty_sigma_xy_m);
+  check.positive("penalty_sigma_theta_rad", c.penalty_sigma_theta_rad);
+  check.not_negative("covariance_response_drop", c.covariance_response_drop);
+  check.in_range("covariance_window_cells", c.covariance_window_cells, 1, 100);
+  check.in_range("max_query_points", c.max_query_points, 1, 100000);
+  if (check.problem()) return check.problem();
+  // The search volume: translations (2 W + 1)^2 per heading, 2 A + 1 headings, and the table's
+  // kernel; more than these take seconds per match.
+  check.require(c.linear_window_m / c.resolution_m <= 1000.0, "linear_window_m",
+                "must be at most 1000 cells of resolution_m");
+  check.require(c.angular_window_rad / c.angle_step_rad <= 1000.0, "angular_window_rad",
+                "must be at most 1000 angle steps");
+  check.require(c.kernel_sigma_m / c.resolution_m <= 100.0, "kernel_sigma_m",
+                "must be at most 100 cells of resolution_m");
+  return check.problem();
 }
 
 CorrelativeMatcher::CorrelativeMatcher(CorrelativeMatcherConfig config)
