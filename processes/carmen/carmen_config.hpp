@@ -1,6 +1,7 @@
 // Settings of the CARMEN log driver.
 #pragma once
 
+#include <optional>
 #include <string>
 
 namespace traverse::carmen {
@@ -30,5 +31,8 @@ struct CarmenConfig {
     v("nominal_scan_period_s", nominal_scan_period_s);
   }
 };
+
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const CarmenConfig& config);
 
 }  // namespace traverse::carmen

@@ -4,9 +4,22 @@
 #include <iterator>
 
 #include "channels.hpp"
+#include "config.hpp"
 #include "se2.hpp"
 
 namespace traverse::carmen {
+
+std::optional<std::string> validate(const CarmenConfig& c) {
+  ConfigCheck check;
+  check.require(
+      parse_flaser_geometry(c.flaser_geometry).has_value(), "flaser_geometry",
+      "must be standard, half_open, closed, centered or reversed, not '" + c.flaser_geometry + "'");
+  check.not_negative("range_min_m", c.range_min_m);
+  check.require(c.range_max_m > c.range_min_m, "range_max_m", "must exceed range_min_m");
+  check.in_range("max_timestamp_quantum_s", c.max_timestamp_quantum_s, 1e-6, 1e9);
+  check.in_range("nominal_scan_period_s", c.nominal_scan_period_s, 1e-6, 3600.0);
+  return check.problem();
+}
 
 planar_scan_t to_scan_message(const Scan& scan, const CarmenConfig& cfg) {
   planar_scan_t msg{};

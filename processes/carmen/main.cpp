@@ -145,24 +145,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   traverse::carmen::CarmenConfig cfg;
   const bool to_file = writes_log_file(argc, argv);
-  if (auto rc = proc.start(argc, argv, cfg, !to_file)) return *rc;
+  if (auto rc = proc.start(argc, argv, cfg, !to_file)) return *rc;  // validate(cfg) included
   const auto geometry = traverse::carmen::parse_flaser_geometry(cfg.flaser_geometry);
-  if (!geometry) {
-    spdlog::error(
-        "traverse-carmen: config error: {}: flaser_geometry: '{}' is not one of "
-        "standard, half_open, closed, centered, reversed",
-        proc.config_path().empty() ? "(defaults)" : proc.config_path(), cfg.flaser_geometry);
-    return traverse::kConfigErrorExitCode;
-  }
   if (log_path.empty()) {
     spdlog::error("traverse-carmen: no CARMEN log given (see --help)");
-    return traverse::kConfigErrorExitCode;
-  }
-  if (!(cfg.max_timestamp_quantum_s > 0.0 && cfg.nominal_scan_period_s > 0.0)) {
-    spdlog::error(
-        "traverse-carmen: config error: {}: max_timestamp_quantum_s and nominal_scan_period_s "
-        "must be positive",
-        proc.config_path().empty() ? "(defaults)" : proc.config_path());
     return traverse::kConfigErrorExitCode;
   }
   traverse::carmen::Reader reader(log_path, *geometry,

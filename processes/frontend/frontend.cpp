@@ -15,13 +15,14 @@ std::unique_ptr<Frontend> make_frontend(const FrontendConfig& config) {
   // travel when the config says so.
   const auto make_member = [config](const Pose2& T_map_base_initial) -> std::unique_ptr<Frontend> {
     FrontendConfig c = config;
-    c.initial_pose = {T_map_base_initial.x(), T_map_base_initial.y(), T_map_base_initial.theta()};
+    c.initial_pose = {.x_m = T_map_base_initial.x(),
+                      .y_m = T_map_base_initial.y(),
+                      .theta_rad = T_map_base_initial.theta()};
     auto hector = std::make_unique<HectorFrontend>(c);
     if (c.matcher.sparse_lag) return std::make_unique<SparseLag>(std::move(hector), c.matcher);
     return std::make_unique<MeasureAndIntegrate>(std::move(hector));
   };
-  const Extrinsic2Config& p = config.initial_pose;
-  const Pose2 T_map_base_initial(p.x_m, p.y_m, p.theta_rad);
+  const Pose2 T_map_base_initial = config.initial_pose.pose();
   const int members = config.matcher.sparse_ensemble_members;
   if (members <= 1) return make_member(T_map_base_initial);
   // The members' grids are offset by fractions of a cell of the wide search's level.

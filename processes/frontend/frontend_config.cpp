@@ -8,15 +8,6 @@
 namespace traverse::frontend {
 namespace {
 
-// A pose of the base or of a sensor on it: x and y within +-max_m, theta within +-2 pi.
-std::optional<std::string> validate_pose(const Extrinsic2Config& c, double max_m) {
-  ConfigCheck check;
-  check.in_range("x_m", c.x_m, -max_m, max_m);
-  check.in_range("y_m", c.y_m, -max_m, max_m);
-  check.in_range("theta_rad", c.theta_rad, -2.0 * M_PI, 2.0 * M_PI);
-  return check.problem();
-}
-
 // A correlative search over +-window_m in x and y on cells of cell_m is exhaustive over (2
 // window_m / cell_m + 1)^2 translations per heading: more than this many cells either side take
 // seconds per scan.
@@ -87,8 +78,8 @@ std::optional<std::string> validate(const FrontendConfig& c) {
   check.not_empty("scan_channel", c.scan_channel);
   check.not_empty("imu_channel", c.imu_channel);
   check.not_empty("pose_channel", c.pose_channel);
-  check.nested("T_base_laser", validate_pose(c.T_base_laser, 100.0));
-  check.nested("initial_pose", validate_pose(c.initial_pose, 1e6));
+  check.nested("T_base_laser", validate(c.T_base_laser));
+  check.nested("initial_pose", validate(c.initial_pose));
   check.nested("map", validate(c.map));
   check.nested("matcher", validate(c.matcher));
   check.nested("deskew", validate(c.deskew));

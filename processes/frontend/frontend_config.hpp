@@ -7,6 +7,7 @@
 #include <string>
 
 #include "channels.hpp"
+#include "pose_config.hpp"
 
 namespace traverse::frontend {
 
@@ -194,30 +195,16 @@ struct DeskewConfig {
   }
 };
 
-// A planar pose T_parent_child: an extrinsic, or a pose in the map frame.
-struct Extrinsic2Config {
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double theta_rad = 0.0;
-
-  template <class V>
-  void visit(V& v) {
-    v("x_m", x_m);
-    v("y_m", y_m);
-    v("theta_rad", theta_rad);
-  }
-};
-
 struct FrontendConfig {
   std::string scan_channel = channels::kScanHorizontal;
   std::string imu_channel = channels::kImu;
   std::string pose_channel = channels::kPoseFrontend;
-  Extrinsic2Config T_base_laser;
+  Pose2Config T_base_laser;  // the horizontal scanner in the base frame
   // Pose of the base at the first scan in the map frame, T_map_base: where the trajectory starts
   // in a site's frame (a surveyed start point). The map's grid is aligned with the map frame, so
   // a sub-cell offset or a small turn here also changes how every scan falls on the cells
   // (scripts/frontend-sensitivity.sh measures what that does to a trajectory).
-  Extrinsic2Config initial_pose;
+  Pose2Config initial_pose;
   MapConfig map;
   MatcherConfig matcher;
   DeskewConfig deskew;

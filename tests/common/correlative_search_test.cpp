@@ -163,7 +163,7 @@ TEST_P(CorrelativeSearches, SpreadIsWideAlongACorridorAndNarrowAcross) {
   const auto corridor = fe::synthetic::corridor(60.0, 2.4);
   const Found found = c.search(corridor, Pose2(0.0, 0.3, 0.0), Pose2(0.1, 0.35, 0.02));
   EXPECT_LT(std::abs(found.pose.y() - 0.3), c.tolerance_m);  // across: found
-  if (!found.covariance) GTEST_SKIP() << c.name << " gives no covariance";
+  if (!found.covariance) return;  // the recovery search gives a pose only
   EXPECT_GT((*found.covariance)(0, 0), 10.0 * (*found.covariance)(1, 1));
   EXPECT_GT(std::sqrt((*found.covariance)(0, 0)), 0.1);  // [m] along: spread over the window
 }

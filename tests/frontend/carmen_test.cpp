@@ -126,7 +126,7 @@ TEST_P(CarmenLog, TracksReference) {
 // track (rpe_10m 2.97 / 4.31 / 4.18 m). Steps outside the 99 % ellipse of their covariance: intel
 // 2.6 %, aces 0 %, csail 6.2 % (median NEES 0.37 / 0.23 / 0.71); with the Gauss-Newton covariance
 // alone and one frontend (matcher.wide_search_temperature 0, sparse_ensemble_members 1): 70 / 60 /
-// 60 %, median 18.7 / 13.3 / 14.5. freiburg-079 is a scanner's stream (Gauss-Newton covariance):
+// 60 %, median 18.8 / 13.3 / 14.5. freiburg-079 is a scanner's stream (Gauss-Newton covariance):
 // 73.5 % outside, median 23.8, not checked.
 INSTANTIATE_TEST_SUITE_P(Logs, CarmenLog,
                          ::testing::Values(LogCase{"freiburg-079", 4700, 0.06, 0.15, 0.5},

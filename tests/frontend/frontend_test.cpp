@@ -104,7 +104,7 @@ TEST(Frontend, ScannerStreamDropsTheSparseEnsemble) {
 // turned, and is tracked as well from there.
 TEST(Frontend, TracksFromTheConfiguredInitialPose) {
   FrontendConfig config;
-  config.initial_pose = {12.337, -4.061, 2.2};
+  config.initial_pose = {.x_m = 12.337, .y_m = -4.061, .theta_rad = 2.2};
   const RoomRun run = run_room(config, false, 0.4);
   EXPECT_LT(run.position_error_m, 0.005);
   EXPECT_LT(run.heading_error_rad, 0.001);
@@ -126,7 +126,7 @@ TEST(Frontend, DeskewReducesErrorWhileTurningFast) {
 // from); the first good scan then starts the map there.
 TEST(Frontend, BlindFirstScanIsPlacedAtTheInitialPose) {
   FrontendConfig config;
-  config.initial_pose = {1.5, -0.25, 0.3};
+  config.initial_pose = {.x_m = 1.5, .y_m = -0.25, .theta_rad = 0.3};
   const auto frontend = make_frontend(config);
   std::mt19937 rng(9);
   const auto world = synthetic::room();

@@ -21,8 +21,6 @@ Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
       .toRotationMatrix();
 }
 
-Pose2 to_pose(const Extrinsic2Config& c) { return Pose2(c.x_m, c.y_m, c.theta_rad); }
-
 // Gives `result` the pose of a match and its figures (iterations add up).
 void take_match(FrontendResult& result, const MatchResult& m) {
   result.T_map_base = m.T_map_base;
@@ -38,8 +36,8 @@ void take_match(FrontendResult& result, const MatchResult& m) {
 
 HectorFrontend::HectorFrontend(const FrontendConfig& config)
     : config_(config),
-      T_initial_(to_pose(config.initial_pose)),
-      scan_points_(to_pose(config.T_base_laser), config.matcher.min_range_m,
+      T_initial_(config.initial_pose.pose()),
+      scan_points_(config.T_base_laser.pose(), config.matcher.min_range_m,
                    config.matcher.max_range_m),
       motion_(T_initial_, rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
                                        config.deskew.imu_yaw_rad)),
@@ -174,7 +172,7 @@ void HectorFrontend::integrate(Measurement& m) {
   motion_.add_pose(r.utime, r.T_map_base, r.covariance, r.sparse);
   r.diagnostics->map_updated = false;
   if (T_map_base_last_update_ && !map_update_due(r.T_map_base)) return;
-  map_.update(r.T_map_base, to_pose(config_.T_base_laser).translation(), m.points);
+  map_.update(r.T_map_base, config_.T_base_laser.pose().translation(), m.points);
   T_map_base_last_update_ = r.T_map_base;
   counters_.map_tiles_evicted += static_cast<int64_t>(map_.bound_memory(
       r.T_map_base.translation(), static_cast<std::size_t>(config_.map.max_bytes)));
