@@ -2,19 +2,19 @@
 
 #include <cmath>
 
+#include "config.hpp"
+
 namespace traverse::evaluator {
 
 std::optional<std::string> validate(const EvaluatorConfig& config) {
-  if (!parse_align(config.align)) {
-    return "align: '" + config.align + "' is not one of none, first_pose, se2";
-  }
-  if (config.match.max_reference_gap_us <= 0) return "max_reference_gap_us: must be positive";
-  if (config.match.edge_tolerance_us < 0) return "edge_tolerance_us: must not be negative";
-  if (!(config.false_closure_sigmas > 0.0) || !std::isfinite(config.false_closure_sigmas)) {
-    return "false_closure_sigmas: must be a positive number of standard deviations";
-  }
-  if (config.key_poses_channel.empty()) return "key_poses_channel: must not be empty";
-  return std::nullopt;
+  ConfigCheck check;
+  check.require(parse_align(config.align).has_value(), "align",
+                "must be none, first_pose or se2, not '" + config.align + "'");
+  check.positive("max_reference_gap_us", config.match.max_reference_gap_us);
+  check.not_negative("edge_tolerance_us", config.match.edge_tolerance_us);
+  check.positive("false_closure_sigmas", config.false_closure_sigmas);
+  check.not_empty("key_poses_channel", config.key_poses_channel);
+  return check.problem();
 }
 
 void shift(Trajectory& trajectory, double dx_m, double dy_m, double dtheta_rad) {

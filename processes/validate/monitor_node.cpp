@@ -3,10 +3,18 @@
 #include <exception>
 
 #include "channels.hpp"
+#include "config.hpp"
 #include "process.hpp"
 #include "traverse/process_status_t.hpp"
 
 namespace traverse {
+
+std::optional<std::string> validate::validate(const MonitorConfig& c) {
+  ConfigCheck check;
+  check.positive("status_timeout_s", c.status_timeout_s);
+  return check.problem();
+}
+
 namespace {
 
 const std::string kStatusPrefix = "STATUS_";

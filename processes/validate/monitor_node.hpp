@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
+#include <optional>
 #include <string>
 
 #include "bus.hpp"
@@ -14,6 +15,8 @@
 
 namespace traverse {
 
+namespace validate {
+
 struct MonitorConfig {
   double status_timeout_s = 3.0;  // [s] a process whose status is not heard for longer is silent
 
@@ -22,6 +25,12 @@ struct MonitorConfig {
     v("status_timeout_s", status_timeout_s);
   }
 };
+
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const MonitorConfig& config);
+
+}  // namespace validate
+using validate::MonitorConfig;
 
 class MonitorNode {
  public:
