@@ -28,8 +28,9 @@ planar_scan_t to_scan_message(const Scan& scan, const CarmenConfig& cfg) {
   msg.angle_first = static_cast<float>(scan.beams.angle_first);
   msg.angle_step = static_cast<float>(scan.beams.angle_step * static_cast<double>(stride));
   double range_max = std::min(cfg.range_max_m, scan.range_max_m.value_or(cfg.range_max_m));
-  if (scan.no_return_code_m)
+  if (scan.no_return_code_m) {
     range_max = std::min(range_max, *scan.no_return_code_m - kBelowNoReturnM);
+  }
   msg.range_min = static_cast<float>(cfg.range_min_m);
   msg.range_max = static_cast<float>(range_max);
   msg.ranges.reserve((n + stride - 1) / stride);

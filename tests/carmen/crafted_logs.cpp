@@ -94,6 +94,19 @@ bool write_log(const std::string& path, const CraftedLog& log) {
   return static_cast<bool>(out.flush());
 }
 
+bool write_relations(const std::string& path, const CraftedLog& log, int gap) {
+  std::ofstream out(path);
+  for (std::size_t i = 0; i + gap < log.poses.size(); ++i) {
+    const Pose2 d = between(log.poses[i], log.poses[i + gap]);
+    char line[160];
+    std::snprintf(line, sizeof line, "%s %s %.6f %.6f 0.000000 0.000000 0.000000 %.6f\n",
+                  log.stamps.at(i).c_str(), log.stamps.at(i + gap).c_str(), d.x(), d.y(),
+                  d.theta());
+    out << line;
+  }
+  return static_cast<bool>(out.flush());
+}
+
 std::vector<std::string> stamps_fine(int n, double period_s) {
   std::vector<std::string> s;
   for (int k = 0; k < n; ++k) {

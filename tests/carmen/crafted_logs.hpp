@@ -24,6 +24,11 @@ struct CraftedLog {
 // Writes the log (plain text); false if the file cannot be written.
 bool write_log(const std::string& path, const CraftedLog& log);
 
+// The relations of the log (the benchmark's format: t1 t2 dx dy dz droll dpitch dyaw, the true
+// pose of scan j in the frame of scan i, stamps as the log prints them) between every scan i and
+// scan i + gap.
+bool write_relations(const std::string& path, const CraftedLog& log, int gap);
+
 // Poses along the floor plan's corridor loop, one every `step_m` of travel (and every 0.35 rad of
 // turn at the corners), as a log subsampled by travel keeps them.
 std::vector<Pose2> loop_path(double step_m);

@@ -7,15 +7,19 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
+#include "bus.hpp"
 #include "channels.hpp"
 #include "crafted_logs.hpp"
 #include "program.hpp"
 #include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
+#include "traverse/process_status_t.hpp"
 
 namespace traverse::carmen::test {
 namespace {
@@ -93,6 +97,51 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(TimeCase{"all_zero", zero, "equal (0 s)"},
                       TimeCase{"negative_then_coarse", negative_then_coarse, "5 negative"},
                       TimeCase{"whole_seconds", whole_seconds, "steps repeat the stamp"}));
+
+// Live, the verdict is in every status: timestamps_without_time 1, the scans placed nominally.
+TEST(TimelessLog, LiveStatusSaysSo) {
+  const std::string url = "udpm://239.255.76.67:31392?ttl=0";
+  Bus bus(url);
+  ASSERT_TRUE(bus.good());
+  int scans = 0, statuses = 0;
+  double without_time = -1.0, restamped = -1.0;
+  bus.subscribe<planar_scan_t>(channels::kScanHorizontal, [&](const planar_scan_t&) { ++scans; });
+  bus.subscribe<process_status_t>(channels::status_channel("carmen"),
+                                  [&](const process_status_t& s) {
+                                    ++statuses;
+                                    for (int i = 0; i < s.n_counters; ++i) {
+                                      if (s.counter_names[i] == "timestamps_without_time") {
+                                        without_time = s.counter_values[i];
+                                      }
+                                      if (s.counter_names[i] == "scans_restamped_nominal") {
+                                        restamped = s.counter_values[i];
+                                      }
+                                    }
+                                  });
+  const auto dir = temp_dir("timeless-live");
+  CraftedLog log;
+  log.poses = loop_path(0.6);
+  log.poses.resize(8);
+  log.stamps = stamps_all_zero(8);
+  ASSERT_TRUE(write_log((dir / "in.log").string(), log));
+  // 8 scans 3 s apart at 20x: about 1 s of wall time.
+  std::thread driver([&] {
+    const auto r =
+        run(kCarmen + " " + (dir / "in.log").string() + " --speed 20 --lcm-url '" + url + "'");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while ((scans < 8 || statuses < 2) && std::chrono::steady_clock::now() < deadline) {
+    bus.handle(100);
+  }
+  driver.join();
+  for (int i = 0; i < 5; ++i) bus.handle(100);  // the final status
+  EXPECT_EQ(scans, 8);
+  EXPECT_GE(statuses, 2);
+  EXPECT_EQ(without_time, 1.0);
+  EXPECT_EQ(restamped, 8.0);
+  fs::remove_all(dir);
+}
 
 // The control: a log whose stamps carry time keeps them exactly.
 TEST(TimedLog, KeepsItsStamps) {
