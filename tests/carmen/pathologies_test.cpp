@@ -258,5 +258,19 @@ TEST(CarmenConfig, BadValuesAreRefusedNamingKeyAndFile) {
   fs::remove_all(dir);
 }
 
+// The builder's log with one 3 m step between kept scans (for the frontend's wide search, whose
+// window is 2 m): exactly one such step, the others as asked.
+TEST(CraftedLogs, LongStepPathHasOneLongStep) {
+  const auto path = loop_path_with_long_step(0.6, 3.0);
+  int long_steps = 0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const double d = (path[i].translation() - path[i - 1].translation()).norm();
+    EXPECT_LE(d, 3.0 + 1e-9);
+    long_steps += d > 2.9;
+  }
+  EXPECT_EQ(long_steps, 1);
+  EXPECT_GT(path.size(), 50u);
+}
+
 }  // namespace
 }  // namespace traverse::carmen::test
