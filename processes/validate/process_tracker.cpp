@@ -4,7 +4,11 @@
 
 namespace traverse::validate {
 
-bool said_stopping(const std::string& state) { return state.rfind("stopping", 0) == 0; }
+bool said_stopping(const std::string& state) {
+  // "stopped" is the last status a process sends after its shutdown work (an export): a
+  // process heard saying it was not silent afterwards, whatever the time since.
+  return state.rfind("stopping", 0) == 0 || state.rfind("stopped", 0) == 0;
+}
 
 void ProcessTracker::add(const std::string& channel, int64_t receive_utime,
                          const ProcessReport& report) {
