@@ -51,7 +51,7 @@ carmen_logs() {  # short LCM logs from the head of each CARMEN log
   local f name
   for f in "$DATA"/carmen/*.log.gz "$DATA"/kummerle/*.log.gz; do
     name="$(basename "$f" .log.gz)"
-    zcat "$f" | head -40 >"$BUILD/corpus/$name.log"
+    { zcat "$f" || true; } | head -40 >"$BUILD/corpus/$name.log"
     "$BUILD/bin/traverse-carmen" "$BUILD/corpus/$name.log" --out "$BUILD/corpus/$name.lcmlog" \
       >/dev/null 2>&1 || true
   done
@@ -81,7 +81,7 @@ PY
     ;;
   carmen_line)
     for f in "$DATA"/carmen/*.log.gz "$DATA"/kummerle/*.log.gz; do
-      zcat "$f" | head -30 | split -l 1 - "$SEEDS/$(basename "$f" .log.gz)-"
+      { zcat "$f" || true; } | head -30 | split -l 1 - "$SEEDS/$(basename "$f" .log.gz)-"
     done
     ;;
   pose_graph)

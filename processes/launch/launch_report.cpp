@@ -31,7 +31,9 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
     r.outcome = c.outcome();
     r.exit_code = c.exit_code;
     r.signal = c.term_signal;
-    const bool infrastructure = c.name == "logger" || c.name == "monitor";
+    // Live, the logger and the monitor run until stopped; offline the monitor ends on its own.
+    const bool infrastructure =
+        c.name == "logger" || (c.name == "monitor" && report.url != "offline");
     if (c.died()) {
       r.failed = true;
       r.why = c.asked_to_stop ? "failed while stopping" : "died";

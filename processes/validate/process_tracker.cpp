@@ -17,8 +17,11 @@ void ProcessTracker::add(const std::string& channel, int64_t receive_utime,
   if (p.statuses == 0) {
     p.first_heard_utime = receive_utime;
   } else {
+    // After "stopping" a process does its shutdown work (an export) without statuses.
     const double gap_s = 1e-6 * (receive_utime - p.last_heard_utime);
-    p.max_status_gap_s = std::max(p.max_status_gap_s.value_or(gap_s), gap_s);
+    if (!said_stopping(p.last.state)) {
+      p.max_status_gap_s = std::max(p.max_status_gap_s.value_or(gap_s), gap_s);
+    }
     if (report.pid != p.last.pid) {
       ++p.restarts;
     } else if (report.seq > p.last.seq + 1) {
