@@ -153,6 +153,13 @@ std::optional<int> Process::connect() {
     spdlog::error("traverse-{}: cannot start LCM with URL '{}'", name_, lcm_url_);
     return 1;
   }
+  beat_ = std::make_unique<StatusBeat>(bus_->lcm(), channels::status_channel(name_),
+                                       [start = start_utime_](process_status_t& st) {
+                                         st.utime = now_utime();
+                                         st.uptime_s = 1e-6 * static_cast<double>(st.utime - start);
+                                         st.cpu_s = cpu_seconds();
+                                         st.rss_bytes = resident_bytes();
+                                       });
   if (!record_path_.empty()) {
     recorder_ = std::make_unique<Recorder>();
     recorder_->log = std::make_unique<lcm::LogFile>(record_path_, "w");
@@ -214,6 +221,7 @@ int Process::replay(const std::function<void()>& tick, const std::function<bool(
 int Process::spin(const std::function<void()>& tick, const std::function<bool()>& until) {
   if (replaying()) return replay(tick, until);
   publish_status("running");
+  beat_->start();
   int rc = 0;
   while (!g_stop && !(until && until())) {
     if (!bus_->handle(100)) {
@@ -225,6 +233,7 @@ int Process::spin(const std::function<void()>& tick, const std::function<bool()>
     if (tick) tick();
     maybe_publish_status();
   }
+  beat_->stop();
   publish_status("stopping");
   return rc;
 }
@@ -234,7 +243,7 @@ void Process::maybe_publish_status() {
 }
 
 void Process::publish_status(const std::string& state) {
-  if (!bus_) return;
+  if (!bus_ || !beat_) return;
   process_status_t st;
   st.utime = now_utime();
   last_status_utime_ = st.utime;
@@ -278,7 +287,9 @@ void Process::publish_status(const std::string& state) {
   st.counter_names.push_back("receive_queue_dropped");
   st.counter_values.push_back(static_cast<double>(bus_->queue_dropped()));
   st.n_counters = static_cast<int32_t>(st.counter_names.size());
-  bus_->publish(channels::status_channel(name_), st);
+  const int64_t utime = st.utime;
+  const int64_t seq = beat_->send(std::move(st));
+  bus_->note_published(channels::status_channel(name_), utime, seq);
 }
 
 }  // namespace traverse

@@ -36,6 +36,7 @@
 
 #include "bus.hpp"
 #include "config.hpp"
+#include "status_beat.hpp"
 
 namespace traverse {
 
@@ -93,7 +94,8 @@ class Process {
   double& counter(const std::string& name) { return counters_[name]; }
 
   // Handles messages until a stop signal or `until()` returns true; calls tick() after each
-  // wake-up (at least every 100 ms). Publishes status once a second and a last one when stopping.
+  // wake-up (at least every 100 ms). Publishes status once a second and a last one when stopping;
+  // live, the status keeps beating while a step takes longer (status_beat.hpp).
   // Returns 0, or 1 if LCM failed.
   int spin(const std::function<void()>& tick = {}, const std::function<bool()>& until = {});
 
@@ -128,6 +130,7 @@ class Process {
   std::string lcm_url_;
   InputConfig input_;
   std::unique_ptr<Bus> bus_;
+  std::unique_ptr<StatusBeat> beat_;  // after bus_: stops before the bus goes
   std::string replay_path_;
   std::string record_path_;
   struct Recorder;
@@ -135,7 +138,6 @@ class Process {
   std::map<std::string, double> counters_;
   int64_t start_utime_ = 0;
   int64_t last_status_utime_ = 0;
-  int64_t status_seq_ = 0;
 };
 
 }  // namespace traverse
