@@ -58,6 +58,9 @@ int mix_pixels(std::vector<BeamReturn>& beams, double angle_step_rad, double exi
     const BeamReturn &a = in[i], &b = in[i + 1];
     if (a.true_range <= 0.0 || b.true_range <= 0.0) continue;
     if (std::abs(a.true_range - b.true_range) <= jump_m) continue;
+    if (std::abs(a.normal.dot(b.point - a.point)) <= jump_m ||
+        std::abs(b.normal.dot(a.point - b.point)) <= jump_m)
+      continue;                      // one surface (slanted), or a corner: no jump
     const double e = rng.uniform();  // the jump at beam i + e steps
     // Beams on a's side (j <= i) reach across to b's surface, and the other way round.
     for (int side = 0; side < 2; ++side) {

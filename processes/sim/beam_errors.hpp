@@ -42,6 +42,8 @@ struct BeamReturn {
   float range = 0.0f;       // [m] measured, 0 = no return
   double true_range = 0.0;  // [m] to the surface it returned from (0: none)
   double power = 0.0;       // relative returned power (reflectivity x cos(incidence) / range^2)
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // [m] world, where it met the surface
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, of that surface
 };
 
 // Beam footprint: radius [m] at range r of a beam with exit diameter d0 and full divergence a.
@@ -50,9 +52,11 @@ inline double footprint_radius(double r, double exit_diameter_m, double divergen
 }
 
 // Mixes the returns of one sweep at every depth jump: for each pair of neighbouring beams whose
-// surfaces differ by more than `jump_m`, the jump is put at a uniform place between them and each
-// beam whose footprint reaches across it returns the power-weighted mean of the two surfaces'
-// ranges (keeping its own bias and noise). Returns the number of beams changed.
+// ranges differ by more than `jump_m` and each of whose points lies more than `jump_m` off the
+// other's surface (not one slanted surface seen at a grazing angle), the jump is put at a uniform
+// place between them and each beam whose footprint reaches across it returns the power-weighted
+// mean of the two surfaces' ranges (keeping its own bias and noise). Returns the number of beams
+// changed.
 int mix_pixels(std::vector<BeamReturn>& beams, double angle_step_rad, double exit_diameter_m,
                double divergence_rad, double jump_m, Rng& rng);
 

@@ -135,8 +135,13 @@ BeamReturn ScannerSim::measure_beam(const Eigen::Vector3d& origin, const Eigen::
     // 8-bit intensity: reflectance seen at this incidence, dimmed towards the detection limit.
     const double level = level0 + rng_.normal(0.01);
     intensity = static_cast<uint8_t>(std::lround(std::clamp(level, 0.0, 1.0) * 255.0));
-    return {static_cast<float>(r), true_range,
-            mat.reflectivity * cos_inc / std::max(true_range * true_range, 1e-6)};
+    BeamReturn out;
+    out.range = static_cast<float>(r);
+    out.true_range = true_range;
+    out.power = mat.reflectivity * cos_inc / std::max(true_range * true_range, 1e-6);
+    out.point = o;
+    out.normal = hit->normal;
+    return out;
   }
   return {};
 }

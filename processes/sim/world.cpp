@@ -395,15 +395,18 @@ double World::distance_to_surface(const Eigen::Vector3d& p, double max_search_m)
   return best;
 }
 
-double World::clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi) const {
+double World::clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi,
+                           std::optional<double> time_s) const {
   double best = kInf;
-  auto overlaps = [&](double z0, double z1) { return z0 <= z_hi && z1 >= z_lo; };
+  auto counts = [&](double z0, double z1, const Lifetime& life) {
+    return z0 <= z_hi && z1 >= z_lo && (!time_s || life.at(*time_s));
+  };
   for (const auto& f : faces_)
-    if (overlaps(f.z0, f.z1)) best = std::min(best, point_segment_distance(xy, f.a, f.b));
+    if (counts(f.z0, f.z1, f.life)) best = std::min(best, point_segment_distance(xy, f.a, f.b));
   for (const auto& c : cylinders_)
-    if (overlaps(c.z0, c.z1)) best = std::min(best, std::max(0.0, (xy - c.c).norm() - c.r));
+    if (counts(c.z0, c.z1, c.life)) best = std::min(best, std::max(0.0, (xy - c.c).norm() - c.r));
   for (const auto& s : slabs_)
-    if (overlaps(s.z, s.z)) best = std::min(best, slab_plane_distance(s, xy));
+    if (counts(s.z, s.z, s.life)) best = std::min(best, slab_plane_distance(s, xy));
   return best;
 }
 

@@ -94,8 +94,10 @@ class World {
   double distance_to_surface(const Eigen::Vector3d& p, double max_search_m = 2.0) const;
 
   // [m] horizontal distance from (x, y) to the nearest obstacle whose height range overlaps
-  // [z_lo, z_hi] (walls, pillars, furniture; not floor or ceiling), searching all objects.
-  double clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi) const;
+  // [z_lo, z_hi] (walls, pillars, furniture; not floor or ceiling), searching all objects (with
+  // `time_s`, those that exist then).
+  double clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi,
+                      std::optional<double> time_s = std::nullopt) const;
 
   const std::string& name() const { return name_; }
   const Material& material(int i) const { return materials_[i]; }
