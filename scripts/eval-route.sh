@@ -4,7 +4,8 @@
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim, configs/sim.yaml and configs/rig.yaml (cached as
-# out/cache/ROUTE-seedN-PROFILE-HASH.lcmlog, HASH of the route, its world, sim.yaml and rig.yaml;
+# out/cache/ROUTE-seedN-PROFILE[-noprofiles]-HASH.lcmlog, HASH of the route, its world, sim.yaml
+# and rig.yaml; without the mapper among the stages the tilted scanner's profiles are left out;
 # regenerated when the sim program is newer), runs the named stages of the graph on it
 # (scripts/run-graph.sh, configs/deploy/pipeline.yaml), and evaluates the last stage's trajectory
 # against the ground truth with traverse-evaluator. With no stage the ground truth is evaluated
@@ -75,6 +76,14 @@ rig_config="$ROOT/configs/rig.yaml"
 [[ -f $sim_config && -f $rig_config ]] || die "configs/sim.yaml or configs/rig.yaml missing"
 inputs_hash="$(cat "$route_file" "$world_file" "$sim_config" "$rig_config" | sha1sum | cut -c 1-10)"
 run_name="$route-seed$seed${duration:+-d$duration}-$profile"
+# Only the mapper reads the tilted profile scanner: without it the log leaves profiles out (a
+# third less to simulate and store). Every other stream is drawn from its own generator, so the
+# scans, IMU and ground truth are the same either way.
+profile_every=()
+if ! runs_mapper "$stages"; then
+  profile_every=(--profile-every 1000000000)
+  run_name="$run_name-noprofiles"
+fi
 cache="$ROOT/out/cache/$run_name-$inputs_hash.lcmlog"
 mkdir -p "$ROOT/out/cache"
 if stale "$cache" "$BIN/traverse-sim"; then
@@ -84,7 +93,7 @@ if stale "$cache" "$BIN/traverse-sim"; then
   sim_start_ns=$(date +%s%N)
   # From the repo root: configs/sim.yaml names the rig file relative to it.
   (cd "$ROOT" && "$BIN/traverse-sim" --config configs/sim.yaml --world "$world_file" \
-    --route "$route_file" --seed "$seed" --profile "$profile" \
+    --route "$route_file" --seed "$seed" --profile "$profile" "${profile_every[@]}" \
     ${duration:+--duration "$duration"} --out "$cache.tmp" >&2) || die "traverse-sim failed"
   mv "$cache.tmp" "$cache"
   echo "eval-route: simulated in $((($(date +%s%N) - sim_start_ns) / 1000000)) ms" >&2

@@ -12,8 +12,8 @@
 namespace traverse::sim {
 namespace {
 
-const char* const kRoutes[] = {"office-x1", "office-x2",  "office-s1",      "office-s2",
-                               "office-s3", "court-loop", "corridor-return"};
+const char* const kRoutes[] = {"office-x1", "office-x2",  "office-s1",       "office-s2",
+                               "office-s3", "court-loop", "corridor-return", "office-rooms"};
 
 RouteSpec load_route(const std::string& name) {
   RouteSpec r;
