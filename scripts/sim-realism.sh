@@ -1,22 +1,26 @@
 #!/usr/bin/env bash
-# scripts/sim-realism.sh [--seed N] [--sim-scans N] [LOG...]
+# scripts/sim-realism.sh [--seed N] [--sim-scans N] [--world NAME --route NAME] [LOG...]
 #
 # The simulator checked against real scans: the SICK LMS200 scans of the full-rate CARMEN logs in
 # ../shared/data/kummerle (intel and aces at 1 deg, fr079 at 0.5 deg) against the same scanner
 # class simulated (configs/rig.yaml: sick_lms200, sick_lms200_half_deg) on a robot driving route
-# office-s2 through the office world with the realistic profile (configs/sim.yaml). Both are
-# measured by the same code (traverse-sim-realism): returns per scan, residuals against the local
-# surface (a line through each beam's two neighbours on either side: robust sigma, 95th
-# percentile, tails), depth jumps, mixed pixels and outliers. Prints the table side by side; the
-# last line is JSON with sigma_ratio and outlier_ratio (simulated over real).
+# lab-loop through the lab world (an office floor like those of the logs: ring corridor, offices,
+# cubicles) with the realistic profile (configs/sim.yaml). Both are measured by the same code
+# (traverse-sim-realism): returns per scan, residuals against the local surface (a line through
+# each beam's two neighbours on either side: robust sigma, 95th percentile, tails), depth jumps,
+# mixed pixels and spikes. Prints the table side by side; the last line is JSON with sigma_ratio
+# (residual sigma) and outlier_ratio (mixed pixels and spikes per depth jump), simulated over real.
+# --world NAME --route NAME compare in another world (e.g. office, office-rooms).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${TRAVERSE_BIN_DIR:-$ROOT/build/bin}"
-seed=1 sim_scans=3000 logs=()
+seed=1 sim_scans=3000 logs=() world=lab route=lab-loop
 while (($#)); do
   case "$1" in
     --seed) seed="${2:?--seed needs a number}"; shift 2 ;;
     --sim-scans) sim_scans="${2:?--sim-scans needs a number}"; shift 2 ;;
+    --world) world="${2:?--world needs a name}"; shift 2 ;;
+    --route) route="${2:?--route needs a name}"; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     -*) echo "sim-realism: unknown option $1" >&2; exit 2 ;;
     *) logs+=("$1"); shift ;;
@@ -33,5 +37,5 @@ done
 [[ -x $BIN/traverse-sim-realism ]] || { echo "sim-realism: $BIN/traverse-sim-realism not built (scripts/setup.sh)" >&2; exit 1; }
 cd "$ROOT"
 exec "$BIN/traverse-sim-realism" "${args[@]}" --config configs/sim.yaml \
-  --world configs/worlds/office.yaml --route configs/routes/office-rooms.yaml --seed "$seed" \
+  --world "configs/worlds/$world.yaml" --route "configs/routes/$route.yaml" --seed "$seed" \
   --sim-scans "$sim_scans"

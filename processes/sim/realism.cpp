@@ -72,6 +72,7 @@ RealismSummary summarize(const ScanStats& s) {
   out.mixed_per_jump = s.jumps > 0 ? static_cast<double>(s.mixed) / s.jumps : 0.0;
   out.outlier_fraction =
       s.returns > 0 ? static_cast<double>(s.outliers + s.mixed) / s.returns : 0.0;
+  out.outliers_per_jump = s.jumps > 0 ? static_cast<double>(s.outliers + s.mixed) / s.jumps : 0.0;
   out.residual_count = static_cast<int64_t>(s.residuals.size());
   if (s.residuals.empty()) return out;
   std::vector<double> abs_res;

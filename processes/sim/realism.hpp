@@ -9,8 +9,9 @@
 //   steps beside it: a wall seen at a grazing angle has long steps too, but alike), mixed pixels
 //   per jump (a point between the two sides of a jump, more than `mixed_margin_m` from both; a
 //   wide footprint can give a jump several), and outliers: mixed pixels and spikes (points off
-//   both neighbours the same way by more than `jump_m`: thin objects, spurious returns), as a
-//   share of returns.
+//   both neighbours the same way by more than `jump_m`: thin objects, spurious returns), per depth
+//   jump (what the sensor makes of the jumps a scene offers) and as a share of returns (which
+//   also counts how cluttered the scene is).
 // Only beams with ranges in [min_range_m, max_range_m] take part.
 #pragma once
 
@@ -50,8 +51,9 @@ struct RealismSummary {
   double tail_fraction = 0.0;     // share of |residual| > 3 sigma
   int64_t residual_count = 0;
   double jumps_per_scan = 0.0;
-  double mixed_per_jump = 0.0;    // mixed pixels (points between the two surfaces) per jump
-  double outlier_fraction = 0.0;  // mixed pixels and spikes, share of returns
+  double mixed_per_jump = 0.0;     // mixed pixels (points between the two surfaces) per jump
+  double outlier_fraction = 0.0;   // mixed pixels and spikes, share of returns
+  double outliers_per_jump = 0.0;  // mixed pixels and spikes per depth jump
 };
 
 RealismSummary summarize(const ScanStats& stats);

@@ -2,8 +2,9 @@
 // (the SICK LMS200 scans of ../shared/data/kummerle), groups them by angular step, simulates the
 // same scanner class (rig models sick_lms200 for 1 deg, sick_lms200_half_deg for 0.5 deg) driven
 // along a route of an office world with the realistic profile, measures both with the same code
-// (realism.hpp), prints them side by side and, last, one JSON line with sigma_ratio and
-// outlier_ratio (simulated over real; each side the mean over the angular steps present).
+// (realism.hpp), prints them side by side and, last, one JSON line with sigma_ratio (robust sigma
+// of the local-line residuals) and outlier_ratio (mixed pixels and spikes per depth jump),
+// simulated over real, each side the mean over the angular steps present.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <map>
@@ -121,7 +122,7 @@ int main(int argc, char** argv) {
   // Side by side, one real and one simulated column per angular step.
   std::vector<std::string> heads;
   std::vector<RealismSummary> cols;
-  double sigma_real = 0, sigma_sim = 0, out_real = 0, out_sim = 0;
+  double sigma_real = 0, sigma_sim = 0, out_real = 0, out_sim = 0, share_real = 0, share_sim = 0;
   int used = 0;
   for (const auto& [key, g] : groups) {
     if (g.model.empty() || g.sim.scans == 0) continue;
@@ -132,8 +133,10 @@ int main(int argc, char** argv) {
     cols.push_back(s);
     sigma_real += r.sigma_m;
     sigma_sim += s.sigma_m;
-    out_real += r.outlier_fraction;
-    out_sim += s.outlier_fraction;
+    out_real += r.outliers_per_jump;
+    out_sim += s.outliers_per_jump;
+    share_real += r.outlier_fraction;
+    share_sim += s.outlier_fraction;
     ++used;
     std::printf(
         "%.1f deg: real %s; simulated %s (%s, %s, seed %llu)\n", key / 10.0,
@@ -179,17 +182,24 @@ int main(int argc, char** argv) {
       "mixed pixels per depth jump", "", [](const RealismSummary& c) { return c.mixed_per_jump; },
       3);
   row(
-      "outliers (off both neighbours)", "%",
+      "outliers (mixed + spikes) per jump", "",
+      [](const RealismSummary& c) { return c.outliers_per_jump; }, 3);
+  row(
+      "outliers (mixed + spikes) of returns", "%",
       [](const RealismSummary& c) { return 100 * c.outlier_fraction; }, 3);
   const double sigma_ratio = sigma_sim / sigma_real, outlier_ratio = out_sim / out_real;
   std::printf(
-      "\nsigma_ratio %.3f, outlier_ratio %.3f (simulated over real, mean over %d step(s))\n",
-      sigma_ratio, outlier_ratio, used);
+      "\nsigma_ratio %.3f (residual sigma), outlier_ratio %.3f (outliers per depth jump); "
+      "simulated over real, mean over %d step(s); outliers of returns %.3f\n",
+      sigma_ratio, outlier_ratio, used, share_sim / share_real);
   std::printf(
       "{\"sigma_ratio\": %.4f, \"outlier_ratio\": %.4f, \"sigma_real_m\": %.5f, "
-      "\"sigma_sim_m\": %.5f, \"outlier_fraction_real\": %.5f, "
-      "\"outlier_fraction_sim\": %.5f, \"steps\": %d, \"seed\": %llu}\n",
+      "\"sigma_sim_m\": %.5f, \"outliers_per_jump_real\": %.4f, \"outliers_per_jump_sim\": %.4f, "
+      "\"outlier_fraction_real\": %.5f, \"outlier_fraction_sim\": %.5f, "
+      "\"outlier_fraction_ratio\": %.4f, \"steps\": %d, \"world\": \"%s\", \"route\": \"%s\", "
+      "\"seed\": %llu}\n",
       sigma_ratio, outlier_ratio, sigma_real / used, sigma_sim / used, out_real / used,
-      out_sim / used, used, static_cast<unsigned long long>(seed));
+      out_sim / used, share_real / used, share_sim / used, share_sim / share_real, used,
+      world_path.c_str(), route_path.c_str(), static_cast<unsigned long long>(seed));
   return 0;
 }

@@ -12,8 +12,9 @@
 namespace traverse::sim {
 namespace {
 
-const char* const kRoutes[] = {"office-x1", "office-x2",  "office-s1",       "office-s2",
-                               "office-s3", "court-loop", "corridor-return", "office-rooms"};
+const char* const kRoutes[] = {"office-x1",       "office-x2",    "office-s1",
+                               "office-s2",       "office-s3",    "court-loop",
+                               "corridor-return", "office-rooms", "lab-loop"};
 
 RouteSpec load_route(const std::string& name) {
   RouteSpec r;
