@@ -96,6 +96,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "traverse-sim-realism: %s\n", e.what());
     return kConfigErrorExitCode;
   }
+  if (auto error = sim::validate(cfg)) {
+    std::fprintf(stderr, "traverse-sim-realism: config error: %s (in %s)\n", error->c_str(),
+                 config_path.c_str());
+    return kConfigErrorExitCode;
+  }
   rig.laser_horizontal.z = laser_height_m;
   for (auto& [key, g] : groups) {
     g.model = key == 10 ? "sick_lms200" : key == 5 ? "sick_lms200_half_deg" : "";
