@@ -52,7 +52,9 @@ ScannerModel quiet(ScannerModel m) {
 
 struct Scene {
   explicit Scene(const WorldSpec& spec, const WorldOptions& options = {})
-      : world(spec, 0.5, options), rng(1), trajectory(standing(), PlatformConfig{}, rng) {}
+      : world(spec, 0.5, options),
+        rng(1),
+        trajectory(standing(), PlatformConfig{}, rng, Effects{}.ideal()) {}
   ScannerSim scanner(const ScannerModel& m, const ScanExtras& extras = {},
                      const Extrinsic& e = {0, 0, 0.5, 0, 0, 0}) {
     return ScannerSim(m, e, "laser", world, trajectory, clock, Rng(2), extras);
@@ -223,7 +225,7 @@ TEST(WorldChanges, ADoorClosesBetweenTheFirstAndSecondPass) {
   r.world = "scene";
   r.waypoints = {{0, 0}, {30, 0}, {0, 0}};
   Rng rng(1);
-  const Trajectory t(r, PlatformConfig{}, rng);
+  const Trajectory t(r, PlatformConfig{}, rng, Effects{}.ideal());
   const double swap = movable_swap_times(spec, t, 8.0).at("door");
   EXPECT_GT((t.nominal_pose(swap).translation() - Eigen::Vector2d(6, 0.5)).norm(), 8.0);
   EXPECT_GT(swap, 20.0);

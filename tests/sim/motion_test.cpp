@@ -104,7 +104,7 @@ TEST(PushedCart, TurnsWhileMovingAndVariesItsSpeed) {
   Rng rng(3);
   const Trajectory pushed(r, PlatformConfig{}, rng, fx);
   Rng rng2(3);
-  const Trajectory stopping(r, PlatformConfig{}, rng2);
+  const Trajectory stopping(r, PlatformConfig{}, rng2, Effects{}.ideal());
   // Stop-and-turn: at each corner the cart stands while it turns. Pushed: while it turns it moves.
   auto min_speed_while_turning = [](const Trajectory& t) {
     double lowest = 1e9;
@@ -146,7 +146,7 @@ TEST(Imu, MeasuresPitchRateAndGravityOnATiltedCart) {
   Rng rng(1);
   PlatformConfig smooth;
   smooth.vibration.clear();
-  Trajectory traj(straight(8.0), smooth, rng);
+  Trajectory traj(straight(8.0), smooth, rng, Effects{}.ideal());
   traj.set_floor(std::make_shared<FloorModel>(spec, floor_only_thresholds(), 0.25, 1));
   ImuModel quiet;
   quiet.gyro_bias_rad_s = quiet.gyro_bias_instability_rad_s = quiet.gyro_arw_rad_sqrt_s = 0.0;
@@ -170,7 +170,7 @@ TEST(Imu, MeasuresPitchRateAndGravityOnATiltedCart) {
 
 TEST(WheelEncoders, RadiusErrorScalesDistanceAndSlipAddsNoise) {
   Rng rng(1);
-  const Trajectory traj(straight(20.0), PlatformConfig{}, rng);
+  const Trajectory traj(straight(20.0), PlatformConfig{}, rng, Effects{}.ideal());
   WheelEncoderEffect e;
   e.enabled = true;
   e.slip_sigma = 0.0;
@@ -209,7 +209,7 @@ TEST(WheelEncoders, RadiusErrorScalesDistanceAndSlipAddsNoise) {
 
 TEST(WheelEncoders, AreStampedByTheirOwnClock) {
   Rng rng(1);
-  const Trajectory traj(straight(5.0), PlatformConfig{}, rng);
+  const Trajectory traj(straight(5.0), PlatformConfig{}, rng, Effects{}.ideal());
   ClockEffect c;
   c.jitter_s = 0.0;
   const SensorClock clock = SensorClock::draw(c, 9, 3);

@@ -33,7 +33,7 @@ RouteSpec standing_then_driving() {
 
 struct Rig {
   explicit Rig(const WorldSpec& spec, const RouteSpec& route = standing_then_driving())
-      : world(spec), rng(1), trajectory(route, PlatformConfig{}, rng) {}
+      : world(spec), rng(1), trajectory(route, PlatformConfig{}, rng, Effects{}.ideal()) {}
   World world;
   Rng rng;
   Trajectory trajectory;

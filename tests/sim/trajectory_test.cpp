@@ -45,7 +45,7 @@ TEST(Routes, OfficeRoutesHaveThePapersLengthsSpeedsAndScanners) {
   for (const char* name : {"office-x1", "office-x2", "office-s1", "office-s2", "office-s3"}) {
     const RouteSpec r = load_route(name);
     Rng rng(1);
-    const Trajectory traj(r, platform, rng);
+    const Trajectory traj(r, platform, rng, Effects{}.ideal());
     EXPECT_EQ(r.world, "office") << name;
     EXPECT_GE(traj.length_m(), 230.0) << name;
     EXPECT_LE(traj.length_m(), 310.0) << name;
@@ -91,7 +91,7 @@ TEST(Trajectory, GroundTruthIsContinuousAndStartsAndEndsAtRest) {
   PlatformConfig platform;
   const RouteSpec r = load_route("office-s2");
   Rng rng(1);
-  const Trajectory traj(r, platform, rng);
+  const Trajectory traj(r, platform, rng, Effects{}.ideal());
   const double dt = 1e-3;
   Pose2 prev = traj.pose(0.0);
   double max_step = 0.0, max_turn = 0.0;
@@ -115,7 +115,7 @@ TEST(Trajectory, VibratesByAFewMillimetresAroundTheNominalPath) {
   PlatformConfig platform;
   const RouteSpec r = load_route("corridor-return");
   Rng rng(3);
-  const Trajectory traj(r, platform, rng);
+  const Trajectory traj(r, platform, rng, Effects{}.ideal());
   double max_offset = 0.0, max_yaw = 0.0;
   for (double t = 0.0; t <= traj.duration_s(); t += 0.01) {
     const Pose2 d = between(traj.nominal_pose(t), traj.pose(t));
