@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "carmen_log.hpp"
+#include "log_reader.hpp"
 #include "config.hpp"
 #include "realism.hpp"
 #include "simulator.hpp"
