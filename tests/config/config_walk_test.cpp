@@ -20,6 +20,7 @@
 #include "frontend_config.hpp"
 #include "mapper.hpp"
 #include "monitor_node.hpp"
+#include "simulator.hpp"
 #include "spa.hpp"
 
 namespace traverse::test {
@@ -125,6 +126,14 @@ TEST_F(ConfigWalk, CloudEval) {
   walk_config<mapper::CloudEvalConfig>(
       walk("traverse-cloud-eval", "configs/cloud-eval-office.yaml",
            {"--world configs/worlds/office.yaml --cloud " + path("mapper/cloud.ply")}));
+}
+
+TEST_F(ConfigWalk, Sim) {
+  // Half a second of the office route: every sensor has published by then.
+  walk_config<sim::SimConfig>(walk("traverse-sim", "configs/sim.yaml",
+                                   {"--world configs/worlds/office.yaml --route "
+                                    "configs/routes/office-s1.yaml --duration 0.5 --out " +
+                                    path("sim.lcmlog")}));
 }
 
 TEST_F(ConfigWalk, Monitor) {
