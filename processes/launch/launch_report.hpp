@@ -12,7 +12,9 @@ namespace traverse::launch {
 struct ChildReport {
   std::string name;
   std::string program;
+  std::string host;     // deployment host ("" when the deployment names none)
   std::string outcome;  // e.g. "exit 0 after SIGINT"
+  int restarts = 0;     // times the launcher started it again after it died
   int exit_code = -1;
   int signal = 0;
   bool failed = false;
@@ -29,6 +31,8 @@ struct RunReport {
   std::vector<ChildReport> children;
   std::vector<std::string> failed;
   std::vector<std::string> verdict_problems;  // input log, monitor's verdict (run_checks.hpp)
+  std::vector<std::string> events;            // deaths and restarts, in order (restart_policy)
+  std::string stopped_by;                     // a process whose death stopped the graph
   bool ok = false;
 };
 
