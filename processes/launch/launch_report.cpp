@@ -56,6 +56,18 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
   return report.verdict_problems.empty() ? 0 : kVerdictFailedExitCode;
 }
 
+std::string processes_json(const Supervisor& sup) {
+  std::string j = "{\"processes\":[";
+  for (const Child& c : sup.children()) {
+    if (j.back() != '[') j += ',';
+    j += "{\"name\":" + quoted(c.name) + ",\"host\":" + quoted(c.host) +
+         ",\"pid\":" + std::to_string(c.pid) + ",\"running\":" + (c.running ? "true" : "false") +
+         ",\"restarts\":" + std::to_string(c.restarts) + ",\"outcome\":" + quoted(c.outcome()) +
+         "}";
+  }
+  return j + "]}";
+}
+
 std::string to_text(const RunReport& report) {
   std::string s = "run-graph: " + report.url + ", replay " + number(report.replay_s) +
                   " s, whole run " + number(report.duration_s) + " s" +

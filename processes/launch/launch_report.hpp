@@ -43,6 +43,10 @@ inline constexpr int kVerdictFailedExitCode = 3;
 // 3 the verdict failed, 130 interrupted without failure).
 int finish_report(RunReport& report, const Supervisor& sup, bool all_started);
 
+// Every child as it is now (name, host, pid, running, restarts, outcome): one JSON object, written
+// by a live launcher to OUTDIR/processes.json whenever a child starts, ends or restarts.
+std::string processes_json(const Supervisor& sup);
+
 std::string to_text(const RunReport& report);
 std::string to_json(const RunReport& report);
 

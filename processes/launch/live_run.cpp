@@ -26,13 +26,26 @@ namespace {
 std::atomic<bool> g_interrupted{false};
 void on_signal(int) { g_interrupted = true; }
 
-// Reaps ended children, says which died, applies the restart policy.
+fs::path g_status_path;  // OUTDIR/processes.json
+
+// Every child's state now, replaced atomically (a reader never sees half a file).
+void write_status(const Supervisor& sup) {
+  if (g_status_path.empty()) return;
+  const fs::path tmp = g_status_path.string() + ".tmp";
+  std::ofstream(tmp) << processes_json(sup) << '\n';
+  std::error_code ec;
+  fs::rename(tmp, g_status_path, ec);
+}
+
+// Reaps ended children, says which died, applies the restart policy, updates processes.json.
 void tick(Supervisor& sup, RestartPolicy& policy) {
   const auto now = RestartPolicy::Clock::now();
   const auto ended = sup.reap();
   announce(ended);
   policy.ended(ended, now);
+  const std::size_t events = policy.events().size();
   policy.restart_due(sup, now);
+  if (!ended.empty() || policy.events().size() != events) write_status(sup);
 }
 
 bool stopping(const RestartPolicy& policy) { return g_interrupted || policy.stop_graph(); }
@@ -141,6 +154,8 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
     stage_names.push_back(p.name);
   }
   if (!spawned) std::fprintf(stderr, "run-graph: %s\n", error.c_str());
+  g_status_path = out_dir / "processes.json";
+  write_status(sup);
   std::fprintf(stderr, "run-graph: LCM URL %s, %zu processes, output in %s\n", o.lcm_url.c_str(),
                plan.stages.size(), out_dir.c_str());
   for (const auto& e : plan.elsewhere) {
@@ -173,6 +188,7 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
     std::snprintf(speed, sizeof(speed), "--speed=%g", o.speed);
     spawned = sup.spawn("logplayer", {plan.player, speed, url_arg, fs::absolute(o.log).string()},
                         (out_dir / "logplayer.log").string(), error, plan.host);
+    write_status(sup);
     if (spawned) wait_while(sup, policy, 1e9, [&] { return sup.find("logplayer")->running; });
   } else if (spawned) {
     wait_while(sup, policy, 1e9, [] { return true; });
@@ -199,6 +215,7 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));  // last messages reach the logger
     sup.stop({"logger"}, o.stop_timeout_s);
   }
+  write_status(sup);
   report.duration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (plan.records && !g_interrupted) {
     for (auto& p : monitor_problems((out_dir / "monitor.json").string())) {
