@@ -13,6 +13,7 @@
 #include <map>
 #include <random>
 
+#include "deployment.hpp"
 #include "graph_test_util.hpp"
 #include "lcm_log.hpp"
 #include "traverse/key_poses_t.hpp"
@@ -198,6 +199,47 @@ TEST(MultiHost, ThreeNamespacesGiveTheProductsOfOneHost) {
   std::ofstream(deploy) << deployment(lan, "0");
   const auto alone = run(run_graph(deploy, dir / "ttl0", "--ready-timeout 2"), 120);
   EXPECT_NE(alone.output.find("no status from 'frontend'"), std::string::npos) << alone.output;
+  if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
+// As in the field: one launcher per host with the same deployment file, here both on this
+// machine. The server's launcher (no log) starts only the frontend and runs until stopped; the
+// cart's replays, records and judges, and hears the frontend on "server".
+TEST(MultiHost, OneLauncherPerHostEachStartsItsOwnProcesses) {
+  const auto dir = temp_dir("field");
+  const auto lease = launch::reserve_port((dir / "ports").string(), 30000, 39999);
+  ASSERT_TRUE(lease);
+  const std::string url = launch::private_url(lease->port(), 8 << 20);
+  const std::string deploy = (dir / "field.yaml").string();
+  std::ofstream(deploy) << "hosts: [{name: cart}, {name: server}]\n"
+                           "processes:\n"
+                           "  - {name: frontend, program: traverse-frontend, "
+                           "config: configs/frontend.yaml, host: server}\n";
+  const std::string bin = "TRAVERSE_BIN_DIR=" + bin_dir() + " scripts/run-graph.sh --deploy " +
+                          deploy + " --lcm-url \"" + url + "\" ";
+  // As an operator would: once the replay is over, the server is stopped first (its frontend's
+  // last pose goes out as it stops), while the cart still records (--grace).
+  const std::string cart_status = (dir / "cart" / "processes.json").string();
+  const auto r = run(
+      bin + "--host server --out " + (dir / "server").string() + " > " +
+          (dir / "server.out").string() + " 2>&1 & server=$!; sleep 1; " + bin +
+          "--host cart --log " + kLog + " --out " + (dir / "cart").string() +
+          " --grace 4 & cart=$!; sleep 2; until grep -q " + "\"logplayer[^}]*running.:false\" " +
+          cart_status +
+          " || ! kill -0 $cart; do sleep 0.2; done; kill -INT $server; wait $server; server=$?; " +
+          "wait $cart; echo cart=$? server=$server; cat " + (dir / "server.out").string(),
+      120);
+  EXPECT_NE(r.output.find("cart=0 server=130"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not started here: frontend (server)"), std::string::npos) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "server" / "frontend.log"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "server" / "run.lcmlog"));  // no recording there
+  const auto counts = count_channels((dir / "cart" / "run.lcmlog").string());
+  EXPECT_EQ(counts.count("POSE_FRONTEND") ? counts.at("POSE_FRONTEND") : 0, 96);
+  bool heard_server = false;
+  for (const auto& s : statuses((dir / "cart" / "run.lcmlog").string())) {
+    heard_server = heard_server || (s.channel == "STATUS_FRONTEND" && s.host == "server");
+  }
+  EXPECT_TRUE(heard_server);
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
