@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "channels.hpp"
+#include "control.hpp"
 #include "launch_report.hpp"
 #include "restart_policy.hpp"
 #include "run_checks.hpp"
@@ -26,7 +27,9 @@ namespace {
 std::atomic<bool> g_interrupted{false};
 void on_signal(int) { g_interrupted = true; }
 
+fs::path g_out_dir;      // OUTDIR: control requests arrive there
 fs::path g_status_path;  // OUTDIR/processes.json
+double g_stop_timeout_s = 5.0;
 
 // Every child's state now, replaced atomically (a reader never sees half a file).
 void write_status(const Supervisor& sup) {
@@ -46,6 +49,13 @@ void tick(Supervisor& sup, RestartPolicy& policy) {
   const std::size_t events = policy.events().size();
   policy.restart_due(sup, now);
   if (!ended.empty() || policy.events().size() != events) write_status(sup);
+  if (const auto request = take_control_request(g_out_dir)) {
+    const std::string done = apply_control(*request, sup, g_stop_timeout_s);
+    std::fprintf(stderr, "run-graph: %s\n", done.c_str());
+    policy.note(done);
+    write_status(sup);
+    done_control_request(g_out_dir);
+  }
 }
 
 bool stopping(const RestartPolicy& policy) { return g_interrupted || policy.stop_graph(); }
@@ -154,6 +164,9 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
     stage_names.push_back(p.name);
   }
   if (!spawned) std::fprintf(stderr, "run-graph: %s\n", error.c_str());
+  g_out_dir = out_dir;
+  g_stop_timeout_s = plan.stop_timeout_s;
+  done_control_request(out_dir);  // a request left from an earlier run is not for this one
   g_status_path = out_dir / "processes.json";
   write_status(sup);
   std::fprintf(stderr, "run-graph: LCM URL %s, %zu processes, output in %s\n", o.lcm_url.c_str(),

@@ -17,6 +17,7 @@
 #include <filesystem>
 
 #include "config.hpp"
+#include "control.hpp"
 #include "deployment.hpp"
 #include "run_modes.hpp"
 
@@ -27,7 +28,7 @@ using traverse::launch::Plan;
 namespace {
 
 void add_options(CLI::App& app, Options& o) {
-  app.add_option("--deploy", o.deploy, "deployment YAML (configs/deploy/)")->required();
+  app.add_option("--deploy", o.deploy, "deployment YAML (configs/deploy/); required to run");
   app.add_option("--log", o.log,
                  "input LCM log to replay (the first host only; without one, live until stopped)");
   app.add_option("--host", o.host,
@@ -53,6 +54,10 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--ready-timeout", o.ready_timeout_s,
                  "[s] to wait for every process's first status before replaying")
       ->capture_default_str();
+  app.add_option("--control", o.control,
+                 "to the launcher running with this --out: start, stop or restart --process NAME, "
+                 "or status (prints OUTDIR/processes.json)");
+  app.add_option("--process", o.process, "with --control: the process");
   app.add_flag("--offline", o.offline,
                "no bus: run the stages one after another on the log (--replay/--record), as "
                "fast as they compute and without transport loss; --speed is ignored");
@@ -89,6 +94,13 @@ int main(int argc, char** argv) {
   add_options(app, o);
   CLI11_PARSE(app, argc, argv);
 
+  if (!o.control.empty()) {
+    return traverse::launch::send_control(o.out, o.control, o.process, o.stop_timeout_s + 30.0);
+  }
+  if (o.deploy.empty()) {
+    std::fprintf(stderr, "run-graph: --deploy is required\n");
+    return traverse::kConfigErrorExitCode;
+  }
   traverse::launch::Deployment deployment;
   try {
     deployment = traverse::launch::load_deployment(o.deploy);

@@ -28,6 +28,9 @@ class RestartPolicy {
   // death given up on.
   void restart_due(Supervisor& sup, Clock::time_point now);
 
+  // An event from elsewhere (a command carried out), in order with the others.
+  void note(const std::string& event) { events_.push_back(event); }
+
   // No more restarts (the graph is stopping).
   void cancel() { due_.clear(); }
 

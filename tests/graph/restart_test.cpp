@@ -122,5 +122,44 @@ TEST(Restart, GivesUpAfterMaxRestartsOrStopsTheGraph) {
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
+// Per-process commands to a running launcher: stop the frontend, see it stopped in the status,
+// start it again, see it running under a new pid; the run's report lists both commands.
+TEST(Restart, ControlStopsAndStartsOneProcessOfARunningGraph) {
+  const auto dir = temp_dir("control");
+  const std::string deploy = (dir / "deploy.yaml").string();
+  std::ofstream(deploy) << "processes:\n"
+                           "  - {name: frontend, program: traverse-frontend, "
+                           "config: configs/frontend.yaml}\n";
+  const std::string control = "TRAVERSE_BIN_DIR=" + bin_dir() + " scripts/run-graph.sh --out " +
+                              (dir / "run").string() + " --control ";
+  const auto status = dir / "run" / "processes.json";
+  std::string stopped, started, listed;
+  std::thread operator_thread([&] {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (std::chrono::steady_clock::now() < deadline && !pid_of(status, "logplayer")) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    stopped = run(control + "stop --process frontend", 60).output;
+    started = run(control + "start --process frontend", 60).output;
+    listed = run(control + "status", 60).output;
+  });
+  const auto r = run(launch(deploy, dir / "run", "--speed 0.25"), 120);
+  operator_thread.join();
+  EXPECT_NE(stopped.find("{\"name\":\"frontend\",\"host\":\"\",\"pid\":"), std::string::npos)
+      << stopped;
+  EXPECT_NE(stopped.find("\"running\":false,\"restarts\":0,\"outcome\":\"exit 0 after SIGINT\""),
+            std::string::npos)
+      << stopped;
+  EXPECT_NE(started.find("\"running\":true,\"restarts\":1"), std::string::npos) << started;
+  EXPECT_NE(listed.find("\"name\":\"logger\""), std::string::npos) << listed;
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("stop frontend: exit 0 after SIGINT"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("start frontend: running (pid "), std::string::npos) << r.output;
+  // Nobody listens any more: a command is refused, not lost silently.
+  EXPECT_EQ(run(control + "stop --process frontend", 60).exit_code, 1);
+  EXPECT_EQ(run(control + "halt --process frontend", 60).exit_code, 2);
+  if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace traverse::graph_test
