@@ -78,28 +78,28 @@ class Lan {
   std::string prefix_;
 };
 
-std::string deployment(const Lan& lan, const std::string& ttl) {
-  return "lcm_url: \"udpm://239.255.76.67:7667?ttl=" + ttl +
-         "&recv_buf_size=8388608\"\n"
-         "hosts:\n"
-         "  - {name: cart, netns: " +
-         lan.ns("cart") +
-         "}\n"
-         "  - {name: server, netns: " +
-         lan.ns("server") +
-         "}\n"
-         "  - {name: mapping, netns: " +
-         lan.ns("mapping") +
-         "}\n"
-         "processes:\n"
-         "  - {name: frontend, program: traverse-frontend, config: configs/frontend.yaml, "
-         "host: server}\n"
-         "  - {name: backend, program: traverse-backend, config: configs/backend.yaml, "
-         "host: server}\n"
-         "  - {name: densifier, program: traverse-densifier, config: configs/densifier.yaml, "
-         "host: mapping}\n"
-         "  - {name: mapper, program: traverse-mapper, config: configs/mapper.yaml, "
-         "args: [--out, \"{out}/mapper\"], stop_timeout_s: 600, host: mapping}\n";
+// The graph with an evaluator of the dense trajectory against the simulator's ground truth: on
+// three hosts of `lan` with `ttl`, or (no lan) on this one.
+std::string deployment(const Lan* lan, const std::string& ttl = "1") {
+  std::string d;
+  const auto on = [&](const std::string& host) { return lan ? ", host: " + host : std::string(); };
+  if (lan) {
+    d = "lcm_url: \"udpm://239.255.76.67:7667?ttl=" + ttl + "&recv_buf_size=8388608\"\nhosts:\n";
+    for (const char* h : {"cart", "server", "mapping"}) {
+      d += "  - {name: " + std::string(h) + ", netns: " + lan->ns(h) + "}\n";
+    }
+  }
+  return d + "processes:\n" +
+         "  - {name: frontend, program: traverse-frontend, config: configs/frontend.yaml" +
+         on("server") + "}\n" +
+         "  - {name: backend, program: traverse-backend, config: configs/backend.yaml" +
+         on("server") + "}\n" +
+         "  - {name: densifier, program: traverse-densifier, config: configs/densifier.yaml" +
+         on("mapping") + "}\n" +
+         "  - {name: mapper, program: traverse-mapper, config: configs/mapper.yaml, " +
+         "args: [--out, \"{out}/mapper\"], stop_timeout_s: 600" + on("mapping") + "}\n" +
+         "  - {name: evaluator, program: traverse-evaluator, config: configs/evaluator.yaml, " +
+         "args: [--estimate, DENSE_SEGMENTS, --out, \"{out}/evaluator\"]" + on("mapping") + "}\n";
 }
 
 std::string run_graph(const std::string& deploy, const std::filesystem::path& out,
@@ -114,6 +114,7 @@ struct Products {
   pose2d_t last_frontend;
   std::map<int64_t, key_pose_t> key_poses;  // newest version of each key pose
   int64_t cloud_points = -1;
+  double dense_rmse_m = -1.0;  // the evaluator's position RMSE of the dense trajectory
 };
 
 Products products(const std::filesystem::path& out) {
@@ -129,6 +130,11 @@ Products products(const std::filesystem::path& out) {
       for (const auto& kp : k.poses) p.key_poses[kp.id] = kp;
     }
   }
+  std::ifstream log(out / "evaluator.log");
+  for (std::string line; std::getline(log, line);) {
+    const auto at = line.find("\"position_rmse_m\": ");
+    if (at != std::string::npos) p.dense_rmse_m = std::stod(line.substr(at + 19));
+  }
   std::ifstream ply(out / "mapper" / "cloud.ply");
   for (std::string line; std::getline(ply, line) && line != "end_header";) {
     if (line.rfind("element vertex ", 0) == 0) p.cloud_points = std::stoll(line.substr(15));
@@ -143,20 +149,20 @@ TEST(MultiHost, ThreeNamespacesGiveTheProductsOfOneHost) {
   ASSERT_EQ(made.exit_code, 0) << "building the namespaces failed:\n" << made.output;
   const auto dir = temp_dir("multi-host");
 
-  const auto one = run(run_graph("configs/deploy/pipeline.yaml", dir / "one"), 120);
+  const std::string single = (dir / "one.yaml").string(), deploy = (dir / "lan.yaml").string();
+  std::ofstream(single) << deployment(nullptr);
+  const auto one = run(run_graph(single, dir / "one"), 120);
   ASSERT_EQ(one.exit_code, 0) << one.output;
-  const std::string deploy = (dir / "lan.yaml").string();
-  std::ofstream(deploy) << deployment(lan, "1");
+  std::ofstream(deploy) << deployment(&lan, "1");
   const auto three = run(run_graph(deploy, dir / "three"), 120);
   ASSERT_EQ(three.exit_code, 0) << three.output;
 
   // Each process reported the host the deployment put it on, and the recording on "cart" heard
   // every one of them across the bridge.
-  const std::map<std::string, std::string> where = {{"STATUS_FRONTEND", "server"},
-                                                    {"STATUS_BACKEND", "server"},
-                                                    {"STATUS_DENSIFIER", "mapping"},
-                                                    {"STATUS_MAPPER", "mapping"},
-                                                    {"STATUS_MONITOR", "cart"}};
+  const std::map<std::string, std::string> where = {
+      {"STATUS_FRONTEND", "server"},   {"STATUS_BACKEND", "server"},
+      {"STATUS_DENSIFIER", "mapping"}, {"STATUS_MAPPER", "mapping"},
+      {"STATUS_EVALUATOR", "mapping"}, {"STATUS_MONITOR", "cart"}};
   std::map<std::string, int> heard;
   for (const auto& s : statuses((dir / "three" / "run.lcmlog").string())) {
     if (!where.count(s.channel)) continue;
@@ -186,17 +192,19 @@ TEST(MultiHost, ThreeNamespacesGiveTheProductsOfOneHost) {
   }
   std::printf(
       "one host / three hosts: %lld / %lld frontend poses, %zu / %zu key poses (largest "
-      "difference %.6f m), %lld / %lld cloud points\n",
+      "difference %.6f m), %lld / %lld cloud points, dense RMSE %.6f / %.6f m\n",
       static_cast<long long>(a.frontend_poses), static_cast<long long>(b.frontend_poses),
       a.key_poses.size(), b.key_poses.size(), worst_m, static_cast<long long>(a.cloud_points),
-      static_cast<long long>(b.cloud_points));
+      static_cast<long long>(b.cloud_points), a.dense_rmse_m, b.dense_rmse_m);
+  ASSERT_GT(a.dense_rmse_m, 0.0);
+  EXPECT_NEAR(b.dense_rmse_m, a.dense_rmse_m, 1e-3);
   ASSERT_GT(a.cloud_points, 1000);
   EXPECT_NEAR(static_cast<double>(b.cloud_points), static_cast<double>(a.cloud_points),
               0.01 * static_cast<double>(a.cloud_points));
 
   // With ttl=0 nothing leaves "cart": the processes on the other hosts are never heard, so the
   // namespaces are really separate machines.
-  std::ofstream(deploy) << deployment(lan, "0");
+  std::ofstream(deploy) << deployment(&lan, "0");
   const auto alone = run(run_graph(deploy, dir / "ttl0", "--ready-timeout 2"), 120);
   EXPECT_NE(alone.output.find("no status from 'frontend'"), std::string::npos) << alone.output;
   if (!HasFailure()) std::filesystem::remove_all(dir);
