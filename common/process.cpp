@@ -36,7 +36,10 @@ int64_t resident_bytes() {
   return resident_pages * sysconf(_SC_PAGESIZE);
 }
 
+// The deployment's name for this machine when a launcher started the process (TRAVERSE_HOST),
+// otherwise the system's host name.
 std::string host_name() {
+  if (const char* deployed = std::getenv("TRAVERSE_HOST"); deployed && *deployed) return deployed;
   char buf[256] = {};
   gethostname(buf, sizeof(buf) - 1);
   return buf;

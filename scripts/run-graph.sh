@@ -3,6 +3,13 @@
 #
 #   scripts/run-graph.sh --deploy configs/deploy/pipeline.yaml --log INPUT.lcmlog --out OUTDIR \
 #       [--speed S] [--stages NAME,NAME|all] [--lcm-url URL] [--grace S] [--stop-timeout S]
+#       [--host NAME]
+#
+# On several machines (hosts and lcm_url with ttl=1 in the deployment file), each machine runs
+# this with the same file and --host NAME; the first host records, judges and replays --log,
+# the others run their processes until stopped (docs/deployment.md). Each process's live state
+# is in OUTDIR/processes.json; a process that dies is handled by its on_death policy. While it
+# runs:  scripts/run-graph.sh --out OUTDIR --control status|start|stop|restart [--process NAME]
 #
 # --speed multiplies the log's own pace (default 1; 0 replays as fast as possible, with losses).
 #

@@ -18,12 +18,41 @@ namespace traverse::launch {
 std::optional<std::string> validate(const StageSpec& s) {
   ConfigCheck check;
   check.in_range("stop_timeout_s", s.stop_timeout_s, 0.0, 3600.0);
+  check.require(s.on_death == "report" || s.on_death == "restart" || s.on_death == "stop_graph",
+                "on_death", "must be report, restart or stop_graph, got '" + s.on_death + "'");
+  check.in_range("max_restarts", s.max_restarts, 0, 1000);
+  check.in_range("restart_delay_s", s.restart_delay_s, 0.0, 600.0);
   return check.problem();
+}
+
+const HostSpec* Deployment::find_host(const std::string& name) const {
+  for (const auto& h : hosts) {
+    if (h.name == name) return &h;
+  }
+  return nullptr;
+}
+
+const HostSpec* Deployment::host_of(const StageSpec& s) const {
+  if (hosts.empty()) return nullptr;
+  return s.host.empty() ? &hosts.front() : find_host(s.host);
 }
 
 Deployment load_deployment(const std::string& path) {
   Deployment d;
   load_config(path, d);
+  std::set<std::string> host_names;
+  for (std::size_t i = 0; i < d.hosts.size(); ++i) {
+    const std::string where = path + ": hosts[" + std::to_string(i) + "]";
+    if (d.hosts[i].name.empty()) throw ConfigError(where + ": key 'name' is missing");
+    if (!host_names.insert(d.hosts[i].name).second) {
+      throw ConfigError(where + ": name '" + d.hosts[i].name + "' used twice");
+    }
+  }
+  if (!d.lcm_url.empty() && d.lcm_url.rfind("udpm://", 0) != 0 &&
+      d.lcm_url.rfind("memq://", 0) != 0) {
+    throw ConfigError(path + ": key 'lcm_url' must be a udpm:// (or memq://) URL, got '" +
+                      d.lcm_url + "'");
+  }
   std::set<std::string> names;
   for (std::size_t i = 0; i < d.processes.size(); ++i) {
     const StageSpec& s = d.processes[i];
@@ -37,8 +66,24 @@ Deployment load_deployment(const std::string& path) {
       throw ConfigError(where + ": name '" + s.name + "' used twice");
     }
     if (const auto problem = validate(s)) throw ConfigError(where + ": " + *problem);
+    if (!s.host.empty() && !d.find_host(s.host)) {
+      throw ConfigError(where + ": key 'host': '" + s.host + "' is not one of the hosts");
+    }
+  }
+  for (auto& s : d.processes) {
+    if (s.host.empty() && !d.hosts.empty()) s.host = d.hosts.front().name;
   }
   return d;
+}
+
+std::vector<StageSpec> started_here(const Deployment& d, const std::vector<StageSpec>& stages,
+                                    const std::string& host) {
+  std::vector<StageSpec> out;
+  for (const auto& s : stages) {
+    const HostSpec* h = d.host_of(s);
+    if (!h || h->name == host || !h->netns.empty()) out.push_back(s);
+  }
+  return out;
 }
 
 std::optional<std::vector<StageSpec>> select_stages(const Deployment& d, const std::string& list,

@@ -28,6 +28,8 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
     ChildReport r;
     r.name = c.name;
     r.program = std::filesystem::path(c.argv.at(0)).filename().string();
+    r.host = c.host;
+    r.restarts = c.restarts;
     r.outcome = c.outcome();
     r.exit_code = c.exit_code;
     r.signal = c.term_signal;
@@ -54,16 +56,34 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
   return report.verdict_problems.empty() ? 0 : kVerdictFailedExitCode;
 }
 
+std::string processes_json(const Supervisor& sup) {
+  std::string j = "{\"processes\":[";
+  for (const Child& c : sup.children()) {
+    if (j.back() != '[') j += ',';
+    j += "{\"name\":" + quoted(c.name) + ",\"host\":" + quoted(c.host) +
+         ",\"pid\":" + std::to_string(c.pid) + ",\"running\":" + (c.running ? "true" : "false") +
+         ",\"restarts\":" + std::to_string(c.restarts) + ",\"outcome\":" + quoted(c.outcome()) +
+         "}";
+  }
+  return j + "]}";
+}
+
 std::string to_text(const RunReport& report) {
   std::string s = "run-graph: " + report.url + ", replay " + number(report.replay_s) +
                   " s, whole run " + number(report.duration_s) + " s" +
                   (report.interrupted ? ", INTERRUPTED" : "") + "\n";
   for (const auto& c : report.children) {
     char line[256];
-    std::snprintf(line, sizeof(line), "  %-12s %-22s %s%s%s\n", c.name.c_str(), c.program.c_str(),
-                  c.outcome.c_str(), c.failed ? "  <-- " : "", c.failed ? c.why.c_str() : "");
+    const std::string restarts =
+        c.restarts ? ", restarted " + std::to_string(c.restarts) + " time(s)" : "";
+    std::snprintf(line, sizeof(line), "  %-12s %-8s %-22s %s%s%s%s\n", c.name.c_str(),
+                  c.host.empty() ? "-" : c.host.c_str(), c.program.c_str(), c.outcome.c_str(),
+                  restarts.c_str(), c.failed ? "  <-- " : "", c.failed ? c.why.c_str() : "");
     s += line;
   }
+  for (const auto& e : report.events) s += "  event: " + e + "\n";
+  if (!report.stopped_by.empty())
+    s += "  the graph was stopped: '" + report.stopped_by + "' died\n";
   for (const auto& n : report.not_ready) s += "  no status before replay from: " + n + "\n";
   for (const auto& p : report.verdict_problems) s += "  VERDICT: " + p + "\n";
   s += report.failed.empty()
@@ -83,7 +103,8 @@ std::string to_json(const RunReport& report) {
   for (std::size_t i = 0; i < report.children.size(); ++i) {
     const auto& c = report.children[i];
     if (i) j += ',';
-    j += "{\"name\":" + quoted(c.name) + ",\"program\":" + quoted(c.program) +
+    j += "{\"name\":" + quoted(c.name) + ",\"host\":" + quoted(c.host) +
+         ",\"program\":" + quoted(c.program) + ",\"restarts\":" + std::to_string(c.restarts) +
          ",\"outcome\":" + quoted(c.outcome) + ",\"exit_code\":" + std::to_string(c.exit_code) +
          ",\"signal\":" + std::to_string(c.signal) +
          ",\"failed\":" + (c.failed ? "true" : "false") + "}";
@@ -98,7 +119,12 @@ std::string to_json(const RunReport& report) {
     if (k) j += ',';
     j += quoted(report.verdict_problems[k]);
   }
-  j += "],\"not_ready\":[";
+  j += "],\"events\":[";
+  for (std::size_t k = 0; k < report.events.size(); ++k) {
+    if (k) j += ',';
+    j += quoted(report.events[k]);
+  }
+  j += "],\"stopped_by\":" + quoted(report.stopped_by) + ",\"not_ready\":[";
   std::size_t i = 0;
   for (const auto& n : report.not_ready) {
     if (i++) j += ',';

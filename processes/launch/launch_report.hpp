@@ -12,7 +12,9 @@ namespace traverse::launch {
 struct ChildReport {
   std::string name;
   std::string program;
+  std::string host;     // deployment host ("" when the deployment names none)
   std::string outcome;  // e.g. "exit 0 after SIGINT"
+  int restarts = 0;     // times the launcher started it again after it died
   int exit_code = -1;
   int signal = 0;
   bool failed = false;
@@ -29,6 +31,8 @@ struct RunReport {
   std::vector<ChildReport> children;
   std::vector<std::string> failed;
   std::vector<std::string> verdict_problems;  // input log, monitor's verdict (run_checks.hpp)
+  std::vector<std::string> events;            // deaths and restarts, in order (restart_policy)
+  std::string stopped_by;                     // a process whose death stopped the graph
   bool ok = false;
 };
 
@@ -38,6 +42,10 @@ inline constexpr int kVerdictFailedExitCode = 3;
 // Fills `report` from the ended children; returns the launcher's exit code (0 ok, 1 a failure,
 // 3 the verdict failed, 130 interrupted without failure).
 int finish_report(RunReport& report, const Supervisor& sup, bool all_started);
+
+// Every child as it is now (name, host, pid, running, restarts, outcome): one JSON object, written
+// by a live launcher to OUTDIR/processes.json whenever a child starts, ends or restarts.
+std::string processes_json(const Supervisor& sup);
 
 std::string to_text(const RunReport& report);
 std::string to_json(const RunReport& report);

@@ -1,7 +1,8 @@
 // Starts child programs and stops them cleanly: fork/exec with stdout and stderr into a log file,
 // each child in its own process group (a terminal's Ctrl-C reaches only the launcher, which then
 // stops the children in graph order) and set to receive SIGTERM if the launcher dies.
-// Stopping escalates SIGINT -> SIGTERM -> SIGKILL with timeouts.
+// Stopping escalates SIGINT -> SIGTERM -> SIGKILL with timeouts. A child may be started inside a
+// network namespace (one that stands in for another machine) and restarted after it died.
 #pragma once
 
 #include <sys/types.h>
@@ -17,6 +18,9 @@ struct Child {
   std::string name;
   std::vector<std::string> argv;
   std::string log_path;
+  std::string host;   // deployment host it runs on ("" when the deployment names none)
+  std::string netns;  // network namespace it was started in ("": the launcher's own)
+  int restarts = 0;   // times it was started again after dying
   pid_t pid = -1;
   bool running = false;
   bool asked_to_stop = false;    // ended after we signalled it (or while we were stopping it)
@@ -30,14 +34,24 @@ struct Child {
   std::string outcome() const;
 };
 
+// Moves the calling process (single-threaded still) into the network namespace `netns` (a name
+// under /run/netns); false with `error` set when it cannot.
+bool enter_netns(const std::string& netns, std::string& error);
+
 class Supervisor {
  public:
   ~Supervisor();  // SIGKILLs children still running
 
-  // Starts argv[0] (a path) with the remaining arguments; false with `error` set if fork fails.
+  // Starts argv[0] (a path) with the remaining arguments; false with `error` set if fork fails
+  // or the network namespace `netns` (a name under /run/netns, "" for none) cannot be opened.
   // A program that cannot be executed ends at once with exit code 127 (message in its log).
+  // `host` reaches the child as TRAVERSE_HOST (the host name its status reports).
   bool spawn(const std::string& name, const std::vector<std::string>& argv,
-             const std::string& log_path, std::string& error);
+             const std::string& log_path, std::string& error, const std::string& host = "",
+             const std::string& netns = "");
+
+  // Starts an ended child again with the same command line, appending to its log.
+  bool respawn(const std::string& name, std::string& error);
 
   // Collects children that ended; returns the ones that ended during this call.
   std::vector<const Child*> reap();
@@ -52,6 +66,7 @@ class Supervisor {
  private:
   void signal_running(const std::vector<std::string>& names, int sig, const char* sig_name);
   bool wait_for(const std::vector<std::string>& names, double timeout_s);
+  bool start(Child& c, bool append_log, std::string& error);
   std::vector<Child> children_;
 };
 

@@ -63,7 +63,9 @@ std::vector<StatusMessage> statuses(const std::string& lcm_log) {
     if (ev->channel.rfind("STATUS_", 0) != 0) continue;
     process_status_t st;
     if (st.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
-    out.push_back({ev->channel, st.utime, st.pid});
+    StatusMessage m{ev->channel, st.utime, st.pid, st.host, {}};
+    for (const auto& c : st.channels) m.missed[c.channel] = c.missed;
+    out.push_back(std::move(m));
   }
   return out;
 }

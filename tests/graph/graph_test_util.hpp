@@ -28,6 +28,8 @@ struct StatusMessage {
   std::string channel;
   int64_t utime = 0;  // [us]
   int32_t pid = 0;
+  std::string host;
+  std::map<std::string, int64_t> missed;  // [messages] per channel, sequence numbers skipped
 };
 std::vector<StatusMessage> statuses(const std::string& lcm_log);
 

@@ -22,6 +22,20 @@ std::string write(const std::filesystem::path& dir, const std::string& name,
   return path;
 }
 
+// Each deployment text is refused with an error naming its needle.
+void expect_refused(const std::filesystem::path& dir,
+                    const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (const auto& [text, needle] : cases) {
+    const auto path = write(dir, "bad.yaml", text);
+    try {
+      load_deployment(path);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(Deployment, LoadsSelectsAndRejects) {
   const auto dir = graph_test::temp_dir("deploy");
   const auto good = write(dir, "good.yaml",
@@ -41,19 +55,51 @@ TEST(Deployment, LoadsSelectsAndRejects) {
   EXPECT_FALSE(select_stages(d, "a,zzz", error));
   EXPECT_NE(error.find("zzz"), std::string::npos);
 
-  for (const auto& [text, needle] : std::vector<std::pair<std::string, std::string>>{
-           {"processes:\n  - {name: a, program: p, confg: x}\n", "confg"},
-           {"processes:\n  - {name: a, program: p}\n  - {name: a, program: q}\n", "twice"},
-           {"processes:\n  - {name: monitor, program: p}\n", "reserved"},
-           {"processes:\n  - {program: p}\n", "name"},
-           {"stages: []\n", "stages"}}) {
-    const auto path = write(dir, "bad.yaml", text);
-    try {
-      load_deployment(path);
-      ADD_FAILURE() << "accepted: " << text;
-    } catch (const ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+  expect_refused(dir,
+                 {{"processes:\n  - {name: a, program: p, confg: x}\n", "confg"},
+                  {"processes:\n  - {name: a, program: p}\n  - {name: a, program: q}\n", "twice"},
+                  {"processes:\n  - {name: monitor, program: p}\n", "reserved"},
+                  {"processes:\n  - {program: p}\n", "name"},
+                  {"stages: []\n", "stages"}});
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Deployment, HostsPoliciesAndWhatEachLauncherStarts) {
+  const auto dir = graph_test::temp_dir("deploy-hosts");
+  const auto path = write(dir, "hosts.yaml",
+                          "lcm_url: 'udpm://239.255.76.67:7667?ttl=1'\n"
+                          "hosts: [{name: cart}, {name: server}, {name: lab, netns: ns-lab}]\n"
+                          "processes:\n"
+                          "  - {name: a, program: p}\n"
+                          "  - {name: b, program: p, host: server, on_death: restart}\n"
+                          "  - {name: c, program: p, host: lab, on_death: stop_graph}\n");
+  const Deployment d = load_deployment(path);
+  EXPECT_EQ(d.lcm_url, "udpm://239.255.76.67:7667?ttl=1");
+  EXPECT_EQ(d.processes[0].host, "cart");  // no host: the first
+  EXPECT_EQ(d.processes[0].on_death, "report");
+  EXPECT_EQ(d.processes[1].max_restarts, 3);
+  const auto names = [](const std::vector<StageSpec>& v) {
+    std::string s;
+    for (const auto& x : v) s += x.name;
+    return s;
+  };
+  // Its own processes, and those of a host standing in a network namespace.
+  EXPECT_EQ(names(started_here(d, d.processes, "cart")), "ac");
+  EXPECT_EQ(names(started_here(d, d.processes, "server")), "bc");
+  Deployment flat;
+  flat.processes = d.processes;
+  EXPECT_EQ(names(started_here(flat, flat.processes, "")), "abc");
+
+  const std::string head = "hosts: [{name: cart}]\nprocesses:\n";
+  expect_refused(dir, {{head + "  - {name: a, program: p, host: moon}\n", "moon"},
+                       {head + "  - {name: a, program: p, on_death: retry}\n", "on_death"},
+                       {head + "  - {name: a, program: p, max_restarts: -1}\n", "max_restarts"},
+                       {"hosts: [{name: x}, {name: x}]\nprocesses: []\n", "twice"},
+                       {"hosts: [{name: x, ip: 1}]\nprocesses: []\n", "ip"},
+                       {"lcm_url: tcpq://x\nprocesses: []\n", "lcm_url"}});
+  // The committed examples load.
+  for (const char* f : {"configs/deploy/pipeline.yaml", "configs/deploy/two-hosts.yaml"}) {
+    EXPECT_NO_THROW(load_deployment(f)) << f;
   }
   std::filesystem::remove_all(dir);
 }
