@@ -1,5 +1,6 @@
 #include "backend.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <chrono>
 #include <cmath>
@@ -14,6 +15,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // The matcher's world-frame covariance of a pose, expressed in that pose's own frame (the frame of
 // the pose graph's edge error).
+// The rotation of (x, y) by theta, the heading left alone.
+Eigen::Matrix3d rotation3(double theta) {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R.topLeftCorner<2, 2>() = Pose2(0.0, 0.0, theta).rotation();
+  return R;
+}
+
 Eigen::Matrix3d to_pose_frame(const Eigen::Matrix3d& covariance_world, const Pose2& T_world_pose) {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   R.topLeftCorner<2, 2>() = T_world_pose.rotation().transpose();
@@ -28,6 +36,9 @@ std::string validate(const BackendConfig& c) {
   if (auto e = validate(c.loop); !e.empty()) return "loop." + e;
   if (auto e = validate(c.spa); !e.empty()) return "spa." + e;
   if (c.link_chain_length < 1) return "link_chain_length must be >= 1";
+  if (!(c.link_covariance_scale > 0.0) || c.link_max_mahalanobis < 0.0) {
+    return "link_covariance_scale must be > 0, link_max_mahalanobis >= 0";
+  }
   if (!(c.fallback_sigma_xy_m > 0.0) || !(c.fallback_sigma_theta_rad > 0.0)) {
     return "fallback sigmas must be > 0";
   }
@@ -36,7 +47,11 @@ std::string validate(const BackendConfig& c) {
   }
   if (c.optimize_every < 1) return "optimize_every must be >= 1";
   if (c.max_pending_scans < 1) return "max_pending_scans must be >= 1";
-  if (c.smoothing.window < 1) return "smoothing.window must be >= 1";
+  if (auto e = validate(c.smoothing); !e.empty()) return "smoothing." + e;
+  if (!(c.frontend_covariance_scale > 0.0) || c.frontend_drift_xy_m < 0.0 ||
+      c.frontend_drift_theta_rad < 0.0) {
+    return "frontend_covariance_scale must be > 0, frontend_drift_* >= 0";
+  }
   return {};
 }
 
@@ -47,7 +62,8 @@ Backend::Backend(BackendConfig config)
       link_matcher_(config_.link),
       link_refiner_(config_.link_refine),
       loop_(config_.loop),
-      spa_(config_.spa) {}
+      spa_(config_.spa),
+      prep_(config_.smoothing) {}
 
 void Backend::add_scan(PlanarScan scan) {
   ++counters_.scans;
@@ -57,64 +73,25 @@ void Backend::add_scan(PlanarScan scan) {
   }
 }
 
-Pose2 Backend::smooth(int64_t utime, const Pose2& T_map_base) {
-  if (tail_.empty()) {
-    last_raw_ = T_map_base;
-    tail_.push_back({utime, T_map_base});
-    return T_map_base;
-  }
-  // The smoothing compares the newest raw step with the preceding (already smoothed) steps.
-  std::vector<StampedPose> window = tail_;
-  window.push_back({utime, tail_.back().T_world_base * between(last_raw_, T_map_base)});
-  const SmoothedTrajectory s = smooth_jumps(window, config_.smoothing);
-  const int n = static_cast<int>(s.poses.size());
-  if (!s.replaced_steps.empty() && s.replaced_steps.back() == n - 1) ++counters_.jumps_smoothed;
-  const Pose2 smoothed =
-      tail_.back().T_world_base * between(s.poses[n - 2].T_world_base, s.poses[n - 1].T_world_base);
-  last_raw_ = T_map_base;
-  tail_.push_back({utime, smoothed});
-  if (static_cast<int>(tail_.size()) > config_.smoothing.window + 1) tail_.erase(tail_.begin());
-  travel_m_ += (smoothed.translation() - tail_[tail_.size() - 2].T_world_base.translation()).norm();
-  return smoothed;
+std::optional<BackendUpdate> Backend::add_pose(int64_t utime, const Pose2& T_map_base,
+                                               const Eigen::Matrix3d& covariance) {
+  const std::optional<PreparedPose> pose = prep_.add({utime, T_map_base, covariance});
+  counters_.prep = prep_.counters();
+  if (!pose) return std::nullopt;
+  return take_pose(*pose);
 }
 
-bool Backend::is_outlier(const StampedPose& held, const StampedPose& next) const {
-  if (tail_.empty()) return false;
-  // The two raw steps appended to the smoothed tail, as smooth() would append them.
-  std::vector<StampedPose> window = tail_;
-  window.push_back({held.utime, tail_.back().T_world_base * between(last_raw_, held.T_world_base)});
-  window.push_back({next.utime, tail_.back().T_world_base * between(last_raw_, next.T_world_base)});
-  const SmoothedTrajectory s = smooth_jumps(std::move(window), config_.smoothing);
-  return !s.outliers.empty() && s.outliers.back() == static_cast<int>(tail_.size());
-}
-
-std::optional<BackendUpdate> Backend::add_pose(int64_t utime, const Pose2& T_map_base) {
-  ++counters_.poses;
-  const StampedPose next{utime, T_map_base};
-  if (!held_) {
-    held_ = next;
-    return std::nullopt;
-  }
-  StampedPose pose = *held_;
-  held_ = next;
-  if (is_outlier(pose, next)) {
-    ++counters_.outliers_replaced;
-    const double s = static_cast<double>(pose.utime - last_key_input_utime_) /
-                     static_cast<double>(std::max<int64_t>(1, next.utime - last_key_input_utime_));
-    pose.T_world_base = interpolate(last_raw_, next.T_world_base, s);
-  }
-  return take_pose(pose.utime, pose.T_world_base);
-}
-
-std::optional<BackendUpdate> Backend::take_pose(int64_t utime, const Pose2& T_map_base) {
-  last_key_input_utime_ = utime;
-  const Pose2 smoothed = smooth(utime, T_map_base);
-  since_key_.push_back({utime, smoothed});
+std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
+  if (!since_key_.empty()) previous_ = since_key_.back();
+  since_key_.push_back(pose);
   const bool first = key_poses_.empty() && since_key_.size() == 1;
-  const std::vector<int> keys = select_key_poses(since_key_, config_.key_poses);
+  std::vector<StampedPose> since;
+  for (const PreparedPose& p : since_key_) since.push_back({p.utime, p.T_world_base});
+  const std::vector<int> keys = select_key_poses(since, config_.key_poses);
   if (!first && keys.back() != static_cast<int>(since_key_.size()) - 1) return std::nullopt;
 
   // The scan this pose belongs to: the one ending at the pose's time (older ones are dropped).
+  const int64_t utime = pose.utime;
   while (!pending_scans_.empty() && pending_scans_.front().utime_last < utime) {
     pending_scans_.pop_front();
   }
@@ -138,15 +115,49 @@ std::optional<BackendUpdate> Backend::take_pose(int64_t utime, const Pose2& T_ma
   return std::nullopt;
 }
 
+Edge Backend::frontend_edge(int from, int to) const {
+  const PreparedPose& a = last_key_;
+  const PreparedPose& b = since_key_.back();
+  Edge edge;
+  edge.from = from;
+  edge.to = to;
+  edge.T_from_to = between(a.T_world_base, b.T_world_base);
+  const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
+  Eigen::Matrix3d covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
+  const Eigen::Matrix3d& Ca = a.frontend.covariance;
+  const Eigen::Matrix3d& Cb = b.frontend.covariance;
+  if (config_.frontend_covariance && !Ca.isZero() && !Cb.isZero() && Ca.allFinite() &&
+      Cb.allFinite()) {
+    // Each pose's error in the frontend's map frame, turned into the prepared frame (they differ
+    // by the jumps smoothed away), carried through the relative pose: J_a C_a J_a^T + J_b C_b
+    // J_b^T with the edge error's Jacobians (pose_graph.hpp).
+    const auto in_world = [](const PreparedPose& p, const Eigen::Matrix3d& C) {
+      const Eigen::Matrix3d R = rotation3(p.T_world_base.theta() - p.frontend.T_map_base.theta());
+      return Eigen::Matrix3d(R * C * R.transpose());
+    };
+    Eigen::Matrix3d J_a, J_b;
+    edge_jacobians(a.T_world_base, b.T_world_base, edge.T_from_to, J_a, J_b);
+    covariance = config_.frontend_covariance_scale * (J_a * in_world(a, Ca) * J_a.transpose() +
+                                                      J_b * in_world(b, Cb) * J_b.transpose());
+    const double travel = std::max(0.0, b.travel_m - a.travel_m);
+    covariance += travel * Eigen::Vector3d(std::pow(config_.frontend_drift_xy_m, 2),
+                                           std::pow(config_.frontend_drift_xy_m, 2),
+                                           std::pow(config_.frontend_drift_theta_rad, 2))
+                               .asDiagonal();
+  }
+  edge.information = covariance.inverse();
+  return edge;
+}
+
 void Backend::add_key_pose(const PlanarScan& scan) {
-  const StampedPose& now = tail_.back();
-  // Motion during the sweep, relative to the key pose: the last smoothed step, at constant
-  // velocity (the frontend publishes one pose per sweep).
+  const PreparedPose& now = since_key_.back();
+  // Motion during the sweep, relative to the key pose: the last prepared step, at constant
+  // velocity (the frontend publishes one pose per sweep), unless the poses come seconds apart
+  // (a log subsampled by travel: the step says nothing about the motion during one sweep).
   Eigen::Vector3d rate = Eigen::Vector3d::Zero();  // tangent per microsecond
-  if (tail_.size() >= 2) {
-    const StampedPose& prev = tail_[tail_.size() - 2];
-    const double dt = static_cast<double>(std::max<int64_t>(1, now.utime - prev.utime));
-    rate = between(prev.T_world_base, now.T_world_base).log() / dt;
+  if (previous_ && !now.sparse) {
+    const double dt = static_cast<double>(std::max<int64_t>(1, now.utime - previous_->utime));
+    rate = between(previous_->T_world_base, now.T_world_base).log() / dt;
   }
   const auto T_ref_base = [&](int64_t t) {
     return Pose2::exp(rate * static_cast<double>(t - now.utime));
@@ -155,24 +166,29 @@ void Backend::add_key_pose(const PlanarScan& scan) {
 
   KeyPose key;
   key.utime = now.utime;
-  key.travel_m = travel_m_;
+  key.travel_m = now.travel_m;
   if (index == 0) {
     graph_.add_vertex(index, now.T_world_base, true);
   } else {
     // Link to the previous key pose: match against the last few key scans around the frontend's
     // relative motion.
     const int prev = index - 1;
-    const Pose2 T_world_guess = graph_.poses[prev] * between(last_key_smoothed_, now.T_world_base);
+    const Pose2 T_world_guess =
+        graph_.poses[prev] * between(last_key_.T_world_base, now.T_world_base);
     std::vector<Eigen::Vector2d> reference;
     for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
       scans_.append_world(j, graph_.poses[j], reference);
     }
     const MatchResult m = link_matcher_.match(reference, scans_.points_d(index), T_world_guess);
-    Pose2 T_world_key = T_world_guess;
-    Eigen::Matrix3d covariance;
+    const bool frontend =
+        config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
+    const Edge motion = frontend_edge(prev, index);
+    Edge link;
+    link.from = prev;
+    link.to = index;
+    bool linked = false;
     if (m.valid && m.raw_response >= config_.min_link_response) {
-      ++counters_.links_matched;
-      T_world_key = m.T_world_query;
+      Pose2 T_world_key = m.T_world_query;
       if (config_.link_refine.enabled) {
         const RefineResult r = link_refiner_.refine(reference, scans_.points_d(index), T_world_key);
         if (r.valid) {
@@ -180,30 +196,44 @@ void Backend::add_key_pose(const PlanarScan& scan) {
           T_world_key = r.T_world_query;
         }
       }
-      covariance = to_pose_frame(m.covariance, T_world_key);
-    } else {
+      link.T_from_to = between(graph_.poses[prev], T_world_key);
+      const Eigen::Matrix3d covariance =
+          config_.link_covariance_scale * to_pose_frame(m.covariance, T_world_key);
+      link.information = covariance.inverse();
+      // The match must agree with the frontend's motion within their covariances: a scan that
+      // fits the last few elsewhere (a corridor, a turn the chain has not seen) is left out.
+      linked = true;
+      if (frontend && config_.link_max_mahalanobis > 0.0) {
+        const Eigen::Vector3d d = edge_error(Pose2(), link.T_from_to, motion.T_from_to);
+        const Eigen::Matrix3d S = covariance + motion.information.inverse();
+        if (std::sqrt(d.dot(S.ldlt().solve(d))) > config_.link_max_mahalanobis) {
+          ++counters_.links_rejected_inconsistent;
+          linked = false;
+        }
+      }
+      if (linked) ++counters_.links_matched;
+    }
+    if (!linked && !frontend) {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;
-      covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-    }
-    graph_.add_vertex(index, T_world_key);
-    Edge edge;
-    edge.from = prev;
-    edge.to = index;
-    edge.T_from_to = between(graph_.poses[prev], T_world_key);
-    edge.information = covariance.inverse();
-    graph_.edges.push_back(edge);
-    if (config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0) {
-      const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
-      edge.T_from_to = between(last_key_smoothed_, now.T_world_base);
-      edge.information =
+      link.T_from_to = between(graph_.poses[prev], T_world_guess);
+      link.information =
           Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (sth * sth)).asDiagonal();
-      graph_.edges.push_back(edge);
+      linked = true;
+    }
+    graph_.add_vertex(index, graph_.poses[prev] * (linked ? link.T_from_to : motion.T_from_to));
+    if (linked) {
+      graph_.edges.push_back(link);
+      edge_kinds_.push_back(EdgeKind::kLink);
+    }
+    if (frontend) {
+      graph_.edges.push_back(motion);
+      edge_kinds_.push_back(EdgeKind::kFrontend);
     }
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
   }
   key_poses_.push_back(key);
-  last_key_smoothed_ = now.T_world_base;
+  last_key_ = now;
 }
 
 void Backend::add_closure(const LoopClosure& closure) {
@@ -213,6 +243,7 @@ void Backend::add_closure(const LoopClosure& closure) {
   edge.T_from_to = closure.T_from_to;
   edge.information = closure.covariance.inverse();
   graph_.edges.push_back(edge);
+  edge_kinds_.push_back(EdgeKind::kClosure);
   closures_.push_back(closure);
 }
 
@@ -247,11 +278,7 @@ std::optional<BackendUpdate> Backend::optimise() {
 
 std::optional<BackendUpdate> Backend::finish() {
   std::optional<BackendUpdate> last;
-  if (held_) {
-    const StampedPose pose = *held_;
-    held_.reset();
-    last = take_pose(pose.utime, pose.T_world_base);
-  }
+  if (const std::optional<PreparedPose> pose = prep_.finish()) last = take_pose(*pose);
   const std::optional<LoopClosure> closure = loop_.finish();
   if (closure) add_closure(*closure);
   if (key_poses_.empty()) return std::nullopt;

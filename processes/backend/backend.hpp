@@ -1,17 +1,19 @@
 // The backend of seed 000 (Karto's mapper and SPA, fed by Hector's trajectory) with the marginal
 // covariances of seed 004, as one algorithm without messaging:
-//   1. the frontend's dense poses are smoothed: the jumps it makes when it recovers at a loop are
-//      replaced by the average of the preceding steps (trajectory_prep.hpp);
+//   1. the frontend's poses are prepared for the input they come from: a scanner's stream has its
+//      jumps at loops smoothed away, a log subsampled by travel is taken as it is
+//      (trajectory_prep.hpp);
 //   2. key poses are picked from them (about three per second, or by distance and angle), and
 //      their scans are kept at reduced density (scan_store.hpp);
-//   3. each new key pose is linked to the previous one by correlative matching (Olson 2009) of its
-//      scan against the last few key scans, searched around the frontend's relative motion with a
-//      penalty for straying from it (correlative_matcher.hpp);
+//   3. each new key pose is linked to the previous one by the frontend's relative motion, with
+//      the covariance the frontend published for both poses, and by correlative matching (Olson
+//      2009) of its scan against the last few key scans, searched around the frontend's relative
+//      motion with a penalty for straying from it (correlative_matcher.hpp);
 //   4. loops are closed with the best of all nearby current scans (loop_closer.hpp);
 //   5. the pose graph is optimised by Sparse Pose Adjustment (spa.hpp) and the marginal
 //      covariance of every key pose is recovered from its sparse Cholesky factor.
 // Frontend poses are T_map_base (the frontend's map frame); key poses are T_world_base in the
-// backend's frame, which starts equal to the smoothed frontend frame (first key pose fixed).
+// backend's frame, which starts equal to the prepared frontend frame (first key pose fixed).
 #pragma once
 
 #include <Eigen/Core>
@@ -52,8 +54,15 @@ struct BackendConfig {
   CorrelativeMatcherConfig link{0.02, 8, 0.003, 0.2, 0.06, 0.03, 0.2, 0.1, 0.05, 8, 400};
   // ... then refined point to line (scan_refiner.hpp); the link keeps the correlative covariance.
   RefinerConfig link_refine;
-  int link_chain_length = 5;               // previous key scans a new key scan is matched against
-  double min_link_response = 0.35;         // below: the frontend's relative motion is used instead
+  int link_chain_length = 5;  // previous key scans a new key scan is matched against
+  // Below this response no link edge; without a frontend edge the frontend's relative motion
+  // stands in, with the fallback sigmas.
+  double min_link_response = 0.35;
+  // The match's covariance (the spread of its response surface) times this [unitless].
+  double link_covariance_scale = 1.0;
+  // A match farther than this Mahalanobis distance from the frontend's motion (under both
+  // covariances) is left out; 0: not checked.
+  double link_max_mahalanobis = 0.0;
   double fallback_sigma_xy_m = 0.05;       // its standard deviation [m]
   double fallback_sigma_theta_rad = 0.02;  // [rad]
   // The frontend's relative motion between consecutive key poses as a second edge beside the
@@ -62,6 +71,15 @@ struct BackendConfig {
   // keeps its precision while matching and loop closures correct the drift.
   double frontend_sigma_xy_m = 0.003;        // [m]
   double frontend_sigma_theta_rad = 0.0005;  // [rad]
+  // The frontend edge's covariance from the covariances the frontend published for its two
+  // poses (each pose's error against the frontend's map, carried through the relative pose),
+  // times frontend_covariance_scale, plus the drift of that map: a random walk of
+  // frontend_drift_xy_m and frontend_drift_theta_rad per square root of a metre travelled.
+  // The fixed sigmas above stand in for a pose published without a covariance.
+  bool frontend_covariance = true;
+  double frontend_covariance_scale = 1.0;  // [unitless]
+  double frontend_drift_xy_m = 0.0;        // [m / sqrt(m)]
+  double frontend_drift_theta_rad = 0.0;   // [rad / sqrt(m)]
   LoopCloserConfig loop;
   SpaConfig spa;
   int optimize_every = 1;       // key poses between optimisations (always at a closure)
@@ -77,10 +95,16 @@ struct BackendConfig {
     v("link_refine", link_refine);
     v("link_chain_length", link_chain_length);
     v("min_link_response", min_link_response);
+    v("link_covariance_scale", link_covariance_scale);
+    v("link_max_mahalanobis", link_max_mahalanobis);
     v("fallback_sigma_xy_m", fallback_sigma_xy_m);
     v("fallback_sigma_theta_rad", fallback_sigma_theta_rad);
     v("frontend_sigma_xy_m", frontend_sigma_xy_m);
     v("frontend_sigma_theta_rad", frontend_sigma_theta_rad);
+    v("frontend_covariance", frontend_covariance);
+    v("frontend_covariance_scale", frontend_covariance_scale);
+    v("frontend_drift_xy_m", frontend_drift_xy_m);
+    v("frontend_drift_theta_rad", frontend_drift_theta_rad);
     v("loop", loop);
     v("spa", spa);
     v("optimize_every", optimize_every);
@@ -99,6 +123,13 @@ struct KeyPose {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
+// What an edge of the backend's graph measures.
+enum class EdgeKind {
+  kLink,      // correlative match of a key scan against the last few (or its fallback)
+  kFrontend,  // the frontend's relative motion between consecutive key poses
+  kClosure,   // a loop closure
+};
+
 struct BackendUpdate {
   int optimisation = 0;                   // 1 for the first optimisation, +1 each
   std::vector<int> new_key_poses;         // key pose indices added since the previous update
@@ -109,14 +140,13 @@ struct BackendUpdate {
 };
 
 struct BackendCounters {
-  long poses = 0;                   // frontend poses received
-  long jumps_smoothed = 0;          // frontend steps replaced by the average
-  long outliers_replaced = 0;       // single frontend poses replaced by their neighbours' average
-  long scans = 0;                   // scans received
-  long key_poses_without_scan = 0;  // key pose deferred: its scan was missing
-  long links_matched = 0;           // consecutive links from correlative matching
-  long links_refined = 0;           // ... of which refined point to line
-  long links_fallback = 0;          // ... from the frontend's motion (response too low)
+  TrajectoryPrepCounters prep;           // frontend poses received, dropped, smoothed
+  long scans = 0;                        // scans received
+  long key_poses_without_scan = 0;       // key pose deferred: its scan was missing
+  long links_matched = 0;                // consecutive links from correlative matching
+  long links_refined = 0;                // ... of which refined point to line
+  long links_fallback = 0;               // ... from the frontend's motion (response too low)
+  long links_rejected_inconsistent = 0;  // matches that contradict the frontend's motion
   long optimisations = 0;
   long optimisations_failed = 0;      // not converged or covariance not recovered
   double last_optimisation_s = 0.0;   // [s]
@@ -133,11 +163,16 @@ class Backend {
   // The frontend pose of the scan ending at `utime`; returns an update when the graph was
   // optimised. Each pose is taken in when the next one arrives (or at finish()): only then can it
   // be told apart from an outlier.
-  std::optional<BackendUpdate> add_pose(int64_t utime, const Pose2& T_map_base);
+  // `covariance`: the frontend's, of (x [m], y [m], theta [rad]) in its map frame (zero: unknown).
+  std::optional<BackendUpdate> add_pose(
+      int64_t utime, const Pose2& T_map_base,
+      const Eigen::Matrix3d& covariance = Eigen::Matrix3d::Zero());
   // End of data: closes an open loop-closure episode and optimises if anything is new.
   std::optional<BackendUpdate> finish();
 
   const PoseGraph& graph() const { return graph_; }
+  // The kind of each edge of graph().edges, in the same order.
+  const std::vector<EdgeKind>& edge_kinds() const { return edge_kinds_; }
   const std::vector<KeyPose>& key_poses() const { return key_poses_; }
   const ScanStore& scans() const { return scans_; }
   const std::vector<LoopClosure>& closures() const { return closures_; }
@@ -147,12 +182,12 @@ class Backend {
   int orderings_reused() const { return spa_.system().orderings_reused(); }
 
  private:
-  Pose2 smooth(int64_t utime, const Pose2& T_map_base);
-  // Whether the held pose is an outlier that `next` returns from (see smooth_jumps).
-  bool is_outlier(const StampedPose& held, const StampedPose& next) const;
-  std::optional<BackendUpdate> take_pose(int64_t utime, const Pose2& T_map_base);
-  // Adds the key pose at the newest smoothed pose with the points of `scan`.
+  std::optional<BackendUpdate> take_pose(const PreparedPose& pose);
+  // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
+  // The frontend's relative motion from the last key pose to the newest prepared pose, with its
+  // covariance in the frame of the newest (the edge error's frame).
+  Edge frontend_edge(int from, int to) const;
   void add_closure(const LoopClosure& closure);
   std::optional<BackendUpdate> optimise();
 
@@ -164,17 +199,15 @@ class Backend {
   SpaOptimizer spa_;
   BackendCounters counters_;
 
+  TrajectoryPrep prep_;
   std::deque<PlanarScan> pending_scans_;
-  std::optional<StampedPose> held_;     // the newest frontend pose, not yet taken in
-  int64_t last_key_input_utime_ = 0;    // [us] time of the last pose taken in
-  std::vector<StampedPose> tail_;       // the last smoothed poses (window + 1)
-  Pose2 last_raw_;                      // the previous frontend pose
-  std::vector<StampedPose> since_key_;  // smoothed poses since the last key pose (inclusive)
-  double travel_m_ = 0.0;
+  std::optional<PreparedPose> previous_;  // the prepared pose before the newest
+  std::vector<PreparedPose> since_key_;   // prepared poses since the last key pose (inclusive)
 
   PoseGraph graph_;
+  std::vector<EdgeKind> edge_kinds_;  // parallel to graph_.edges
   std::vector<KeyPose> key_poses_;
-  Pose2 last_key_smoothed_;  // smoothed pose of the last key pose
+  PreparedPose last_key_;  // prepared pose of the last key pose
   ScanStore scans_;
   std::vector<LoopClosure> closures_;
   int first_unreported_key_ = 0;

@@ -37,7 +37,11 @@ void BackendNode::on_scan(const planar_scan_t& msg) { backend_.add_scan(to_plana
 
 void BackendNode::on_pose(const pose2d_t& msg) {
   if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
-  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta))) publish(*update);
+  Eigen::Matrix3d covariance;
+  for (int i = 0; i < 9; ++i) covariance(i / 3, i % 3) = msg.covariance[i];
+  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta), covariance)) {
+    publish(*update);
+  }
 }
 
 void BackendNode::finish() {
@@ -141,15 +145,18 @@ void BackendNode::report_counters() {
   if (!counters_) return;
   const BackendCounters& c = backend_.counters();
   const LoopCloserCounters& l = backend_.loop_counters();
-  counters_("poses_received", static_cast<double>(c.poses));
+  counters_("poses_received", static_cast<double>(c.prep.poses));
+  counters_("poses_out_of_order", static_cast<double>(c.prep.out_of_order));
+  counters_("poses_sparse", static_cast<double>(c.prep.sparse_poses));
   counters_("scans_received", static_cast<double>(c.scans));
-  counters_("jumps_smoothed", static_cast<double>(c.jumps_smoothed));
-  counters_("outliers_replaced", static_cast<double>(c.outliers_replaced));
+  counters_("jumps_smoothed", static_cast<double>(c.prep.jumps_smoothed));
+  counters_("outliers_replaced", static_cast<double>(c.prep.outliers_replaced));
   counters_("key_poses", static_cast<double>(backend_.key_poses().size()));
   counters_("key_poses_without_scan", static_cast<double>(c.key_poses_without_scan));
   counters_("links_matched", static_cast<double>(c.links_matched));
   counters_("links_fallback", static_cast<double>(c.links_fallback));
   counters_("links_refined", static_cast<double>(c.links_refined));
+  counters_("links_rejected_inconsistent", static_cast<double>(c.links_rejected_inconsistent));
   counters_("loop_closures", static_cast<double>(backend_.closures().size()));
   counters_("loop_episodes", static_cast<double>(l.episodes));
   counters_("loop_candidates", static_cast<double>(l.candidates));

@@ -17,6 +17,7 @@ std::string validate(const LoopCloserConfig& c) {
   if (c.max_ambiguity_ratio <= 0.0 || c.ambiguity_exclusion_m <= 0.0) {
     return "max_ambiguity_ratio and ambiguity_exclusion_m must be > 0";
   }
+  if (!(c.covariance_scale > 0.0)) return "covariance_scale must be > 0";
   if (auto e = validate(c.coarse); !e.empty()) return "coarse." + e;
   if (auto e = validate(c.fine); !e.empty()) return "fine." + e;
   if (auto e = validate(c.refine); !e.empty()) return "refine." + e;
@@ -63,7 +64,7 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   }
 
   Pose2 T_world_current = fine.T_world_query;
-  Eigen::Matrix3d covariance = fine.covariance;
+  Eigen::Matrix3d covariance = config_.covariance_scale * fine.covariance;
   if (config_.refine.enabled) {
     const RefineResult refined = refiner_.refine(reference, query, fine.T_world_query);
     if (refined.valid) {

@@ -45,6 +45,9 @@ struct LoopCloserConfig {
   //    covariance and the marginals of both key poses: above this Mahalanobis distance the
   //    closure contradicts the graph (0: not checked).
   double max_correction_mahalanobis = 5.0;
+  // The closure's covariance is the fine match's (the spread of its response surface) times
+  // this [unitless].
+  double covariance_scale = 1.0;
   // Matcher settings in field order: resolution_m, coarse_factor, angle_step_rad,
   // linear_window_m, angular_window_rad, kernel_sigma_m, penalty_sigma_xy_m,
   // penalty_sigma_theta_rad, covariance_response_drop, covariance_window_cells, max_query_points.
@@ -73,6 +76,7 @@ struct LoopCloserConfig {
     v("max_sigma_xy_m", max_sigma_xy_m);
     v("max_sigma_theta_rad", max_sigma_theta_rad);
     v("max_correction_mahalanobis", max_correction_mahalanobis);
+    v("covariance_scale", covariance_scale);
     v("coarse", coarse);
     v("fine", fine);
     v("refine", refine);
@@ -100,8 +104,8 @@ struct LoopCloserCounters {
   long rejected_response = 0;  // coarse or fine response too low
   long rejected_ambiguous = 0;
   long rejected_covariance = 0;
-  long refined = 0;        // fine matches refined point to line
-  long refine_failed = 0;  // ... where refinement failed (the fine match is kept)
+  long refined = 0;                // fine matches refined point to line
+  long refine_failed = 0;          // ... where refinement failed (the fine match is kept)
   long rejected_inconsistent = 0;  // correction too large for the marginals
   long closures = 0;
 };

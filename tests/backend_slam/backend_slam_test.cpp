@@ -88,7 +88,7 @@ TEST(Backend, SmoothsAFrontendJumpAway) {
     backend.add_pose(d.utimes[k], d.input[k]);
   }
   backend.finish();
-  EXPECT_EQ(backend.counters().jumps_smoothed, 1);
+  EXPECT_EQ(backend.counters().prep.jumps_smoothed, 1);
   const int64_t utime = backend.key_poses().back().utime;
   const std::size_t k = static_cast<std::size_t>(
       std::find(d.utimes.begin(), d.utimes.end(), utime) - d.utimes.begin());
