@@ -124,10 +124,12 @@ Edge Backend::frontend_edge(int from, int to) const {
   edge.T_from_to = between(a.T_world_base, b.T_world_base);
   const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
   Eigen::Matrix3d covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-  const Eigen::Matrix3d& Ca = a.frontend.covariance;
-  const Eigen::Matrix3d& Cb = b.frontend.covariance;
-  if (config_.frontend_covariance && !Ca.isZero() && !Cb.isZero() && Ca.allFinite() &&
-      Cb.allFinite()) {
+  // A pose without a covariance (the frontend's first, which defines its map) takes the other's.
+  const auto usable = [](const Eigen::Matrix3d& C) { return !C.isZero() && C.allFinite(); };
+  const Eigen::Matrix3d& Ca =
+      usable(a.frontend.covariance) ? a.frontend.covariance : b.frontend.covariance;
+  const Eigen::Matrix3d& Cb = usable(b.frontend.covariance) ? b.frontend.covariance : Ca;
+  if (config_.frontend_covariance && usable(Ca) && usable(Cb)) {
     // Each pose's error in the frontend's map frame, turned into the prepared frame (they differ
     // by the jumps smoothed away), carried through the relative pose: J_a C_a J_a^T + J_b C_b
     // J_b^T with the edge error's Jacobians (pose_graph.hpp).

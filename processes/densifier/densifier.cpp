@@ -145,6 +145,7 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   const StampedPose& a = dense_[n - 3];
   const StampedPose& b = dense_[n - 1];
   StampedPose& p = dense_[n - 2];
+  if (b.utime - a.utime > config_.spike_max_span_us) return;
   const Pose2 q = interpolate_between(a, b, p.utime);
   const double off = (p.T_world_base.translation() - q.translation()).norm();
   const double chord = (b.T_world_base.translation() - a.T_world_base.translation()).norm();
@@ -200,8 +201,8 @@ std::vector<Segment> Densifier::settle() {
   return out;
 }
 
-void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it,
-                                std::vector<Segment>& out, bool exact) {
+void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out,
+                                bool exact) {
   if (it == keys_.end()) return;
   auto next = std::next(it);
   if (next == keys_.end() || !it->second.placed || !next->second.placed) return;

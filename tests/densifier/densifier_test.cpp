@@ -162,8 +162,8 @@ TEST(Densifier, MovesBelowTheThresholdWaitUntilTheEnd) {
 TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
   Densifier d(DensifierConfig{});
   std::vector<Segment> closed;
-  ASSERT_TRUE(d.update_key_poses({{0, kT0, Pose2()}, {1, kT0 + 20 * kDt, Pose2(0.1, 0, 0)}})
-                  .empty());
+  ASSERT_TRUE(
+      d.update_key_poses({{0, kT0, Pose2()}, {1, kT0 + 20 * kDt, Pose2(0.1, 0, 0)}}).empty());
   for (int i = 0; i <= 20; ++i) {
     d.add_dense(kT0 + i * kDt, Pose2(0.005 * i, i == 10 ? 0.15 : 0.0, 0), &closed);
   }
@@ -192,6 +192,23 @@ TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
   f.add_dense(kT0 + 1'000'000, Pose2(1, 0, 0), &closed);
   f.add_dense(kT0 + 2'000'000, Pose2(1, 1, 0), &closed);
   EXPECT_EQ(f.spikes_replaced(), 0);
+
+  // A sparse log turning on the spot (CARMEN intel, scans 336-338): the middle pose comes 3.65 s
+  // after the first and 0.18 s before the last, 6 cm off the path interpolated by time, which is
+  // shorter; its neighbours lie 3.83 s apart, so nothing is known of the path between them, and
+  // it is kept.
+  const auto turn = [](const DensifierConfig& config) {
+    Densifier g(config);
+    std::vector<Segment> out;
+    g.add_dense(kT0, Pose2(17.0311, -0.6614, 1.8256), &out);
+    g.add_dense(kT0 + 3'650'000, Pose2(17.0485, -0.6493, 1.6204), &out);
+    g.add_dense(kT0 + 3'830'000, Pose2(16.9879, -0.6737, 2.1498), &out);
+    return g.spikes_replaced();
+  };
+  EXPECT_EQ(turn(DensifierConfig{}), 0);
+  DensifierConfig any_span;
+  any_span.spike_max_span_us = 4'000'000;
+  EXPECT_EQ(turn(any_span), 1);  // what the check did before it looked at the span
 }
 
 }  // namespace
