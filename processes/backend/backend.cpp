@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "frontend_chain.hpp"
+
 namespace traverse::backend {
 namespace {
 
@@ -15,13 +17,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // The matcher's world-frame covariance of a pose, expressed in that pose's own frame (the frame of
 // the pose graph's edge error).
-// The rotation of (x, y) by theta, the heading left alone.
-Eigen::Matrix3d rotation3(double theta) {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = Pose2(0.0, 0.0, theta).rotation();
-  return R;
-}
-
 Eigen::Matrix3d to_pose_frame(const Eigen::Matrix3d& covariance_world, const Pose2& T_world_pose) {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   R.topLeftCorner<2, 2>() = T_world_pose.rotation().transpose();
@@ -35,10 +30,9 @@ std::string validate(const BackendConfig& c) {
   if (auto e = validate(c.link_refine); !e.empty()) return "link_refine." + e;
   if (auto e = validate(c.loop); !e.empty()) return "loop." + e;
   if (auto e = validate(c.spa); !e.empty()) return "spa." + e;
+  if (c.closure_max_chi2_increase < 0.0) return "closure_max_chi2_increase must be >= 0";
   if (c.link_chain_length < 1) return "link_chain_length must be >= 1";
-  if (!(c.link_covariance_scale > 0.0) || c.link_max_mahalanobis < 0.0) {
-    return "link_covariance_scale must be > 0, link_max_mahalanobis >= 0";
-  }
+  if (!(c.link_covariance_scale > 0.0)) return "link_covariance_scale must be > 0";
   if (!(c.fallback_sigma_xy_m > 0.0) || !(c.fallback_sigma_theta_rad > 0.0)) {
     return "fallback sigmas must be > 0";
   }
@@ -48,21 +42,23 @@ std::string validate(const BackendConfig& c) {
   if (c.optimize_every < 1) return "optimize_every must be >= 1";
   if (c.max_pending_scans < 1) return "max_pending_scans must be >= 1";
   if (auto e = validate(c.smoothing); !e.empty()) return "smoothing." + e;
-  if (!(c.frontend_covariance_scale > 0.0) || c.frontend_drift_xy_m < 0.0 ||
-      c.frontend_drift_theta_rad < 0.0) {
-    return "frontend_covariance_scale must be > 0, frontend_drift_* >= 0";
+  if (!(c.frontend_covariance_scale > 0.0) || c.frontend_drift_length_m < 0.0) {
+    return "frontend_covariance_scale must be > 0, frontend_drift_length_m >= 0";
   }
   return {};
 }
 
 Backend::Backend(BackendConfig config)
     : config_(std::move(config)),
+      drift_model_(config_.frontend_drift_length_m > 0.0 && config_.frontend_sigma_xy_m > 0.0 &&
+                   config_.frontend_sigma_theta_rad > 0.0),
       T_base_laser_(config_.T_base_laser.x_m, config_.T_base_laser.y_m,
                     config_.T_base_laser.theta_rad),
       link_matcher_(config_.link),
       link_refiner_(config_.link_refine),
       loop_(config_.loop),
       spa_(config_.spa),
+      trial_spa_(config_.spa),
       prep_(config_.smoothing) {}
 
 void Backend::add_scan(PlanarScan scan) {
@@ -108,47 +104,42 @@ std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
   for (std::size_t i = 0; i < travel.size(); ++i) travel[i] = key_poses_[i].travel_m;
   std::vector<Eigen::Matrix3d> marginals(key_poses_.size());
   for (std::size_t i = 0; i < marginals.size(); ++i) marginals[i] = key_poses_[i].covariance;
-  const std::optional<LoopClosure> closure =
-      loop_.add(current, graph_.poses, travel, scans_, &marginals);
+  std::vector<Pose2> poses(key_poses_.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) poses[i] = key_poses_[i].T_world_base;
+  const std::optional<LoopClosure> closure = loop_.add(current, poses, travel, scans_, &marginals);
   if (closure) add_closure(*closure);
   if (closure || current % config_.optimize_every == 0) return optimise();
   return std::nullopt;
 }
 
-Edge Backend::frontend_edge(int from, int to) const {
+void Backend::add_frontend_edges(int key) {
+  const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
+  const Eigen::Matrix3d fixed = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
+  const double scale = config_.frontend_covariance ? config_.frontend_covariance_scale : 0.0;
+  const auto covariance = [&](const PreparedPose& p) {
+    return scale > 0.0 ? frontend_pose_covariance(p, scale, fixed) : fixed;
+  };
   const PreparedPose& a = last_key_;
   const PreparedPose& b = since_key_.back();
-  Edge edge;
-  edge.from = from;
-  edge.to = to;
-  edge.T_from_to = between(a.T_world_base, b.T_world_base);
-  const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
-  Eigen::Matrix3d covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-  // A pose without a covariance (the frontend's first, which defines its map) takes the other's.
-  const auto usable = [](const Eigen::Matrix3d& C) { return !C.isZero() && C.allFinite(); };
-  const Eigen::Matrix3d& Ca =
-      usable(a.frontend.covariance) ? a.frontend.covariance : b.frontend.covariance;
-  const Eigen::Matrix3d& Cb = usable(b.frontend.covariance) ? b.frontend.covariance : Ca;
-  if (config_.frontend_covariance && usable(Ca) && usable(Cb)) {
-    // Each pose's error in the frontend's map frame, turned into the prepared frame (they differ
-    // by the jumps smoothed away), carried through the relative pose: J_a C_a J_a^T + J_b C_b
-    // J_b^T with the edge error's Jacobians (pose_graph.hpp).
-    const auto in_world = [](const PreparedPose& p, const Eigen::Matrix3d& C) {
-      const Eigen::Matrix3d R = rotation3(p.T_world_base.theta() - p.frontend.T_map_base.theta());
-      return Eigen::Matrix3d(R * C * R.transpose());
-    };
-    Eigen::Matrix3d J_a, J_b;
-    edge_jacobians(a.T_world_base, b.T_world_base, edge.T_from_to, J_a, J_b);
-    covariance = config_.frontend_covariance_scale * (J_a * in_world(a, Ca) * J_a.transpose() +
-                                                      J_b * in_world(b, Cb) * J_b.transpose());
-    const double travel = std::max(0.0, b.travel_m - a.travel_m);
-    covariance += travel * Eigen::Vector3d(std::pow(config_.frontend_drift_xy_m, 2),
-                                           std::pow(config_.frontend_drift_xy_m, 2),
-                                           std::pow(config_.frontend_drift_theta_rad, 2))
-                               .asDiagonal();
+  Eigen::Matrix3d ca = covariance(a);
+  const Eigen::Matrix3d cb = covariance(b);
+  // The frontend's first pose defines its map and carries no covariance: it takes its
+  // neighbour's.
+  if (scale > 0.0 && a.frontend.covariance.isZero()) ca = cb;
+  if (!drift_model_) {
+    graph_.edges.push_back(motion_edge(key_vertex(key - 1), key_vertex(key), a, b, ca, cb));
+    edge_kinds_.push_back(EdgeKind::kFrontend);
+    return;
   }
-  edge.information = covariance.inverse();
-  return edge;
+  const int m_a = key_vertex(key - 1) + 1, m_b = key_vertex(key) + 1;
+  graph_.edges.push_back(drift_edge(m_a, m_b, a, b, ca, cb, config_.frontend_drift_length_m));
+  edge_kinds_.push_back(EdgeKind::kFrontendDrift);
+  Edge pose;
+  pose.from = m_b;
+  pose.to = key_vertex(key);
+  pose.information = cb.inverse();
+  graph_.edges.push_back(pose);
+  edge_kinds_.push_back(EdgeKind::kFrontendPose);
 }
 
 void Backend::add_key_pose(const PlanarScan& scan) {
@@ -164,87 +155,98 @@ void Backend::add_key_pose(const PlanarScan& scan) {
   const auto T_ref_base = [&](int64_t t) {
     return Pose2::exp(rate * static_cast<double>(t - now.utime));
   };
-  const int index = scans_.add(reduce_scan(scan, T_base_laser_, T_ref_base, config_.scans));
+  // The scan store and the graph are changed only at the end, together, so that they stay in
+  // step even if anything before throws.
+  std::vector<Eigen::Vector2f> points = reduce_scan(scan, T_base_laser_, T_ref_base, config_.scans);
+  const int index = scans_.size();
 
   KeyPose key;
   key.utime = now.utime;
   key.travel_m = now.travel_m;
+  const bool frontend = config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
   if (index == 0) {
-    graph_.add_vertex(index, now.T_world_base, true);
+    key.T_world_base = now.T_world_base;
+    graph_.add_vertex(key_vertex(0), now.T_world_base, true);
+    // The drifting frontend starts where the key poses do: both are fixed there.
+    if (drift_model_) graph_.add_vertex(key_vertex(0) + 1, now.T_world_base, true);
   } else {
     // Link to the previous key pose: match against the last few key scans around the frontend's
     // relative motion.
     const int prev = index - 1;
-    const Pose2 T_world_guess =
-        graph_.poses[prev] * between(last_key_.T_world_base, now.T_world_base);
+    const Pose2 motion = between(last_key_.T_world_base, now.T_world_base);
+    const Pose2 T_world_guess = key_poses_[prev].T_world_base * motion;
     std::vector<Eigen::Vector2d> reference;
     for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
-      scans_.append_world(j, graph_.poses[j], reference);
+      scans_.append_world(j, key_poses_[j].T_world_base, reference);
     }
-    const MatchResult m = link_matcher_.match(reference, scans_.points_d(index), T_world_guess);
-    const bool frontend =
-        config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
-    const Edge motion = frontend_edge(prev, index);
+    std::vector<Eigen::Vector2d> query(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) query[i] = points[i].cast<double>();
+    const MatchResult m = link_matcher_.match(reference, query, T_world_guess);
     Edge link;
-    link.from = prev;
-    link.to = index;
+    link.from = key_vertex(prev);
+    link.to = key_vertex(index);
     bool linked = false;
     if (m.valid && m.raw_response >= config_.min_link_response) {
       Pose2 T_world_key = m.T_world_query;
       if (config_.link_refine.enabled) {
-        const RefineResult r = link_refiner_.refine(reference, scans_.points_d(index), T_world_key);
+        const RefineResult r = link_refiner_.refine(reference, query, T_world_key);
         if (r.valid) {
           ++counters_.links_refined;
           T_world_key = r.T_world_query;
         }
       }
-      link.T_from_to = between(graph_.poses[prev], T_world_key);
-      const Eigen::Matrix3d covariance =
-          config_.link_covariance_scale * to_pose_frame(m.covariance, T_world_key);
-      link.information = covariance.inverse();
-      // The match must agree with the frontend's motion within their covariances: a scan that
-      // fits the last few elsewhere (a corridor, a turn the chain has not seen) is left out.
+      link.T_from_to = between(key_poses_[prev].T_world_base, T_world_key);
+      link.information =
+          (config_.link_covariance_scale * to_pose_frame(m.covariance, T_world_key)).inverse();
       linked = true;
-      if (frontend && config_.link_max_mahalanobis > 0.0) {
-        const Eigen::Vector3d d = edge_error(Pose2(), link.T_from_to, motion.T_from_to);
-        const Eigen::Matrix3d S = covariance + motion.information.inverse();
-        if (std::sqrt(d.dot(S.ldlt().solve(d))) > config_.link_max_mahalanobis) {
-          ++counters_.links_rejected_inconsistent;
-          linked = false;
-        }
-      }
-      if (linked) ++counters_.links_matched;
-    }
-    if (!linked && !frontend) {
+      ++counters_.links_matched;
+    } else if (!frontend) {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;
-      link.T_from_to = between(graph_.poses[prev], T_world_guess);
+      link.T_from_to = motion;
       link.information =
           Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (sth * sth)).asDiagonal();
       linked = true;
     }
-    graph_.add_vertex(index, graph_.poses[prev] * (linked ? link.T_from_to : motion.T_from_to));
+    key.T_world_base = key_poses_[prev].T_world_base * (linked ? link.T_from_to : motion);
+    graph_.add_vertex(key_vertex(index), key.T_world_base);
+    if (drift_model_) {
+      graph_.add_vertex(key_vertex(index) + 1, graph_.poses[key_vertex(prev) + 1] * motion);
+    }
     if (linked) {
       graph_.edges.push_back(link);
       edge_kinds_.push_back(EdgeKind::kLink);
     }
-    if (frontend) {
-      graph_.edges.push_back(motion);
-      edge_kinds_.push_back(EdgeKind::kFrontend);
-    }
+    if (frontend) add_frontend_edges(index);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
   }
+  scans_.add(std::move(points));
   key_poses_.push_back(key);
   last_key_ = now;
 }
 
-void Backend::add_closure(const LoopClosure& closure) {
+void Backend::add_closure(LoopClosure closure) {
   Edge edge;
-  edge.from = closure.from;
-  edge.to = closure.to;
+  edge.from = key_vertex(closure.from);
+  edge.to = key_vertex(closure.to);
   edge.T_from_to = closure.T_from_to;
   edge.information = closure.covariance.inverse();
-  graph_.edges.push_back(edge);
+  if (config_.closure_max_chi2_increase > 0.0) {
+    // The graph at its optimum without the closure, and a copy with it: the growth of chi2 is
+    // the closure's disagreement with everything else, weighed by both covariances.
+    const SpaResult without = spa_.optimize(graph_);
+    PoseGraph trial = graph_;
+    trial.edges.push_back(edge);
+    const SpaResult with = trial_spa_.optimize(trial);
+    closure.chi2_increase = with.final_chi2 - without.final_chi2;
+    if (!(closure.chi2_increase <= config_.closure_max_chi2_increase)) {
+      ++counters_.closures_rejected_inconsistent;
+      return;
+    }
+    graph_ = std::move(trial);
+  } else {
+    graph_.edges.push_back(edge);
+  }
   edge_kinds_.push_back(EdgeKind::kClosure);
   closures_.push_back(closure);
 }
@@ -257,8 +259,9 @@ std::optional<BackendUpdate> Backend::optimise() {
   const auto t1 = std::chrono::steady_clock::now();
   const auto marginals = spa_.marginals(graph_);
   update.marginals_s = seconds_since(t1);
-  if (marginals) {
-    for (std::size_t i = 0; i < key_poses_.size(); ++i) key_poses_[i].covariance = (*marginals)[i];
+  for (int i = 0; i < static_cast<int>(key_poses_.size()); ++i) {
+    key_poses_[i].T_world_base = graph_.poses[key_vertex(i)];
+    if (marginals) key_poses_[i].covariance = (*marginals)[key_vertex(i)];
   }
   ++counters_.optimisations;
   // A graph of the fixed first key pose alone has nothing to optimise.

@@ -60,9 +60,6 @@ struct BackendConfig {
   double min_link_response = 0.35;
   // The match's covariance (the spread of its response surface) times this [unitless].
   double link_covariance_scale = 1.0;
-  // A match farther than this Mahalanobis distance from the frontend's motion (under both
-  // covariances) is left out; 0: not checked.
-  double link_max_mahalanobis = 0.0;
   double fallback_sigma_xy_m = 0.05;       // its standard deviation [m]
   double fallback_sigma_theta_rad = 0.02;  // [rad]
   // The frontend's relative motion between consecutive key poses as a second edge beside the
@@ -71,16 +68,21 @@ struct BackendConfig {
   // keeps its precision while matching and loop closures correct the drift.
   double frontend_sigma_xy_m = 0.003;        // [m]
   double frontend_sigma_theta_rad = 0.0005;  // [rad]
-  // The frontend edge's covariance from the covariances the frontend published for its two
-  // poses (each pose's error against the frontend's map, carried through the relative pose),
-  // times frontend_covariance_scale, plus the drift of that map: a random walk of
-  // frontend_drift_xy_m and frontend_drift_theta_rad per square root of a metre travelled.
-  // The fixed sigmas above stand in for a pose published without a covariance.
+  // How the frontend's trajectory enters the graph (frontend_chain.hpp): each key pose's error
+  // is the covariance the frontend published for it (times frontend_covariance_scale; the fixed
+  // sigmas above stand in for a pose published without one, or for all with
+  // frontend_covariance false), and the frontend's map drifts by as much as one such error over
+  // frontend_drift_length_m of travel (a random walk). 0: no drift model, the frontend's motion
+  // between consecutive key poses is an edge with both poses' covariances.
   bool frontend_covariance = true;
   double frontend_covariance_scale = 1.0;  // [unitless]
-  double frontend_drift_xy_m = 0.0;        // [m / sqrt(m)]
-  double frontend_drift_theta_rad = 0.0;   // [rad / sqrt(m)]
+  double frontend_drift_length_m = 0.0;    // [m]
   LoopCloserConfig loop;
+  // A closure is added to a copy of the graph and both are optimised: if the graph's chi2 grows
+  // by more than this, the closure contradicts the graph and is left out (0: not checked). For a
+  // closure that agrees with the graph, the growth follows a chi-square law with 3 degrees of
+  // freedom (99.9 %: 16.3).
+  double closure_max_chi2_increase = 0.0;
   SpaConfig spa;
   int optimize_every = 1;       // key poses between optimisations (always at a closure)
   int max_pending_scans = 500;  // scans kept while waiting for their pose (~35 KB each)
@@ -96,16 +98,15 @@ struct BackendConfig {
     v("link_chain_length", link_chain_length);
     v("min_link_response", min_link_response);
     v("link_covariance_scale", link_covariance_scale);
-    v("link_max_mahalanobis", link_max_mahalanobis);
     v("fallback_sigma_xy_m", fallback_sigma_xy_m);
     v("fallback_sigma_theta_rad", fallback_sigma_theta_rad);
     v("frontend_sigma_xy_m", frontend_sigma_xy_m);
     v("frontend_sigma_theta_rad", frontend_sigma_theta_rad);
     v("frontend_covariance", frontend_covariance);
     v("frontend_covariance_scale", frontend_covariance_scale);
-    v("frontend_drift_xy_m", frontend_drift_xy_m);
-    v("frontend_drift_theta_rad", frontend_drift_theta_rad);
+    v("frontend_drift_length_m", frontend_drift_length_m);
     v("loop", loop);
+    v("closure_max_chi2_increase", closure_max_chi2_increase);
     v("spa", spa);
     v("optimize_every", optimize_every);
     v("max_pending_scans", max_pending_scans);
@@ -117,6 +118,7 @@ std::string validate(const BackendConfig& config);
 
 struct KeyPose {
   int64_t utime = 0;      // [us] time of the frontend pose (its scan's last point)
+  Pose2 T_world_base;     // the estimate of the last optimisation (or the first guess)
   double travel_m = 0.0;  // [m] distance along the smoothed trajectory
   // Marginal covariance of (x [m], y [m], theta [rad]) in the world frame: m^2, m rad, rad^2.
   // Zero for the first key pose (it fixes the gauge).
@@ -125,9 +127,11 @@ struct KeyPose {
 
 // What an edge of the backend's graph measures.
 enum class EdgeKind {
-  kLink,      // correlative match of a key scan against the last few (or its fallback)
-  kFrontend,  // the frontend's relative motion between consecutive key poses
-  kClosure,   // a loop closure
+  kLink,           // correlative match of a key scan against the last few (or its fallback)
+  kFrontend,       // the frontend's relative motion between consecutive key poses
+  kFrontendDrift,  // ... between consecutive poses of the drifting frontend (frontend_chain.hpp)
+  kFrontendPose,   // a key pose against the drifting frontend's pose (frontend_chain.hpp)
+  kClosure,        // a loop closure
 };
 
 struct BackendUpdate {
@@ -140,13 +144,13 @@ struct BackendUpdate {
 };
 
 struct BackendCounters {
-  TrajectoryPrepCounters prep;           // frontend poses received, dropped, smoothed
-  long scans = 0;                        // scans received
-  long key_poses_without_scan = 0;       // key pose deferred: its scan was missing
-  long links_matched = 0;                // consecutive links from correlative matching
-  long links_refined = 0;                // ... of which refined point to line
-  long links_fallback = 0;               // ... from the frontend's motion (response too low)
-  long links_rejected_inconsistent = 0;  // matches that contradict the frontend's motion
+  TrajectoryPrepCounters prep;              // frontend poses received, dropped, smoothed
+  long scans = 0;                           // scans received
+  long key_poses_without_scan = 0;          // key pose deferred: its scan was missing
+  long links_matched = 0;                   // consecutive links from correlative matching
+  long links_refined = 0;                   // ... of which refined point to line
+  long links_fallback = 0;                  // ... from the frontend's motion (response too low)
+  long closures_rejected_inconsistent = 0;  // closures the trial optimisation refused
   long optimisations = 0;
   long optimisations_failed = 0;      // not converged or covariance not recovered
   double last_optimisation_s = 0.0;   // [s]
@@ -170,7 +174,14 @@ class Backend {
   // End of data: closes an open loop-closure episode and optimises if anything is new.
   std::optional<BackendUpdate> finish();
 
+  // The pose graph: besides the key poses (vertex key_vertex(i) for key pose i) it may hold the
+  // drifting frontend's poses (frontend_chain.hpp).
   const PoseGraph& graph() const { return graph_; }
+  int key_vertex(int key) const { return drift_model_ ? 2 * key : key; }
+  // The key pose of a vertex, -1 for the drifting frontend's.
+  int key_of_vertex(int vertex) const {
+    return drift_model_ ? (vertex % 2 == 0 ? vertex / 2 : -1) : vertex;
+  }
   // The kind of each edge of graph().edges, in the same order.
   const std::vector<EdgeKind>& edge_kinds() const { return edge_kinds_; }
   const std::vector<KeyPose>& key_poses() const { return key_poses_; }
@@ -185,18 +196,20 @@ class Backend {
   std::optional<BackendUpdate> take_pose(const PreparedPose& pose);
   // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
-  // The frontend's relative motion from the last key pose to the newest prepared pose, with its
-  // covariance in the frame of the newest (the edge error's frame).
-  Edge frontend_edge(int from, int to) const;
-  void add_closure(const LoopClosure& closure);
+  // Adds the frontend's edges of the new key pose `key` (frontend_chain.hpp).
+  void add_frontend_edges(int key);
+  // Adds the closure unless a trial optimisation finds it inconsistent with the graph.
+  void add_closure(LoopClosure closure);
   std::optional<BackendUpdate> optimise();
 
   BackendConfig config_;
+  bool drift_model_;  // the frontend's edges follow the drift model (frontend_chain.hpp)
   Pose2 T_base_laser_;
   CorrelativeMatcher link_matcher_;
   ScanRefiner link_refiner_;
   LoopCloser loop_;
   SpaOptimizer spa_;
+  SpaOptimizer trial_spa_;  // for the graph with a closure on trial
   BackendCounters counters_;
 
   TrajectoryPrep prep_;

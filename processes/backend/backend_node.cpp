@@ -51,7 +51,7 @@ void BackendNode::finish() {
 bool BackendNode::changed(int i) const {
   if (i >= static_cast<int>(published_.size())) return true;
   const Published& p = published_[i];
-  const Pose2& T = backend_.graph().poses[i];
+  const Pose2& T = backend_.key_poses()[i].T_world_base;
   if ((T.translation() - p.T_world_base.translation()).norm() > config_.publish_move_m) return true;
   if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
     return true;
@@ -74,7 +74,7 @@ void BackendNode::publish(const BackendUpdate& update) {
     if (changed(i)) changed_ids.push_back(i);
   }
   published_.resize(keys.size());
-  for (int i : changed_ids) published_[i] = {graph.poses[i], keys[i].covariance.diagonal()};
+  for (int i : changed_ids) published_[i] = {keys[i].T_world_base, keys[i].covariance.diagonal()};
 
   const int per = config_.max_poses_per_message;
   const int parts = std::max(1, static_cast<int>((changed_ids.size() + per - 1) / per));
@@ -96,9 +96,9 @@ void BackendNode::publish(const BackendUpdate& update) {
       key_pose_t p{};
       p.utime = keys[i].utime;
       p.id = i;
-      p.x = graph.poses[i].x();
-      p.y = graph.poses[i].y();
-      p.theta = graph.poses[i].theta();
+      p.x = keys[i].T_world_base.x();
+      p.y = keys[i].T_world_base.y();
+      p.theta = keys[i].T_world_base.theta();
       copy_matrix(keys[i].covariance, p.covariance);
       msg.poses.push_back(p);
     }
@@ -132,9 +132,9 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.utime = keys[i].utime;
     pose.parent_frame = "world";
     pose.child_frame = "base";
-    pose.x = graph.poses[i].x();
-    pose.y = graph.poses[i].y();
-    pose.theta = graph.poses[i].theta();
+    pose.x = keys[i].T_world_base.x();
+    pose.y = keys[i].T_world_base.y();
+    pose.theta = keys[i].T_world_base.theta();
     copy_matrix(keys[i].covariance, pose.covariance);
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
@@ -156,7 +156,6 @@ void BackendNode::report_counters() {
   counters_("links_matched", static_cast<double>(c.links_matched));
   counters_("links_fallback", static_cast<double>(c.links_fallback));
   counters_("links_refined", static_cast<double>(c.links_refined));
-  counters_("links_rejected_inconsistent", static_cast<double>(c.links_rejected_inconsistent));
   counters_("loop_closures", static_cast<double>(backend_.closures().size()));
   counters_("loop_episodes", static_cast<double>(l.episodes));
   counters_("loop_candidates", static_cast<double>(l.candidates));
@@ -166,6 +165,7 @@ void BackendNode::report_counters() {
   counters_("loop_refined", static_cast<double>(l.refined));
   counters_("loop_refine_failed", static_cast<double>(l.refine_failed));
   counters_("loop_rejected_inconsistent", static_cast<double>(l.rejected_inconsistent));
+  counters_("loop_rejected_graph", static_cast<double>(c.closures_rejected_inconsistent));
   counters_("optimisations", static_cast<double>(c.optimisations));
   counters_("optimisations_failed", static_cast<double>(c.optimisations_failed));
   counters_("optimisation_last_s", c.last_optimisation_s);

@@ -96,6 +96,9 @@ struct LoopClosure {
   double response = 0.0;     // fine raw response [0..1]
   double second_peak = 0.0;  // coarse ambiguity ratio (second peak / peak)
   int candidates_tried = 0;  // candidates of the episode
+  // [unitless] how much the pose graph's chi2 grew when the closure was added (the backend's
+  // trial optimisation); 0 when not checked.
+  double chi2_increase = 0.0;
 };
 
 struct LoopCloserCounters {
