@@ -1,6 +1,10 @@
 # Generates C++ headers for every lcmtypes/*.lcm into the build tree (never committed), and a
-# registry that maps each type's fingerprint to a decode check (used by traverse-validate).
+# registry that maps each type's fingerprint to a decode check (used by traverse-validate) and to
+# the type's layout, taken from lcm-gen's own parse of the files (`lcm-gen -d`), so that a
+# message's bytes can be checked against every length it claims before it is decoded
+# (common/message_layout.hpp).
 file(GLOB LCM_FILES CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/lcmtypes/*.lcm)
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${LCM_FILES})
 set(LCM_OUT ${CMAKE_BINARY_DIR}/lcmtypes)
 set(LCM_HEADERS "")
 set(registry_includes "")
@@ -11,6 +15,11 @@ foreach(f ${LCM_FILES})
   string(APPEND registry_includes "#include \"traverse/${type}.hpp\"\n")
   string(APPEND registry_entries "      entry<traverse::${type}>(\"traverse.${type}\"),\n")
 endforeach()
+execute_process(COMMAND ${LCM_GEN} -d ${LCM_FILES} OUTPUT_VARIABLE registry_layouts
+  RESULT_VARIABLE lcm_gen_rc)
+if(NOT lcm_gen_rc EQUAL 0)
+  message(FATAL_ERROR "lcm-gen -d failed on lcmtypes/*.lcm")
+endif()
 add_custom_command(
   OUTPUT ${LCM_HEADERS}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${LCM_OUT}
@@ -19,7 +28,8 @@ add_custom_command(
   COMMENT "lcm-gen: generating C++ message types")
 add_custom_target(lcmtypes_gen DEPENDS ${LCM_HEADERS})
 configure_file(${CMAKE_SOURCE_DIR}/cmake/type_registry.cpp.in ${CMAKE_BINARY_DIR}/generated/type_registry.cpp @ONLY)
-add_library(traverse_lcmtypes STATIC ${CMAKE_BINARY_DIR}/generated/type_registry.cpp)
+add_library(traverse_lcmtypes STATIC ${CMAKE_BINARY_DIR}/generated/type_registry.cpp
+  ${CMAKE_SOURCE_DIR}/common/message_layout.cpp ${CMAKE_SOURCE_DIR}/common/message_checks.cpp)
 add_dependencies(traverse_lcmtypes lcmtypes_gen)
 # Generated code is not ours to warn about: include it as a system directory.
 target_include_directories(traverse_lcmtypes SYSTEM PUBLIC ${LCM_OUT})

@@ -9,7 +9,16 @@
 
 namespace traverse {
 
-Bus::Bus(const std::string& url) : url_(url), lcm_(url), threaded_(url.rfind("memq://", 0) != 0) {}
+Bus::Bus(const std::string& url, const InputConfig& input)
+    : url_(url),
+      input_(input),
+      limits_(array_limits(input)),
+      lcm_(url),
+      threaded_(url.rfind("memq://", 0) != 0) {}
+
+int64_t Bus::max_stamp_jump_us() const {
+  return static_cast<int64_t>(std::min(1e6 * input_.max_stamp_jump_s, 9e18));
+}
 
 Bus::~Bus() {
   stop_reading_ = true;
@@ -99,20 +108,36 @@ void Bus::send(const std::string& channel, const uint8_t* data, std::size_t size
   lcm_.publish(channel, data, static_cast<unsigned int>(size));
 }
 
-bool Bus::admit(const std::string& channel, int64_t utime, int64_t seq, bool accept_out_of_order) {
+void Bus::count_sequence(const std::string& channel, int64_t seq) {
+  if (seq < 0) return;
   ChannelStats& s = stats_[channel];
-  if (seq >= 0) {
-    // A sequence number below the last one means the producer restarted: start counting afresh.
-    if (s.last_seq >= 0 && seq > s.last_seq + 1) s.missed += seq - s.last_seq - 1;
-    s.last_seq = seq;
+  // A sequence number below the last one means the producer restarted: start counting afresh.
+  if (s.last_seq >= 0 && seq > s.last_seq + 1) s.missed += seq - s.last_seq - 1;
+  s.last_seq = seq;
+}
+
+void Bus::count_order(const std::string& channel, const StampOrder::Step& step) {
+  ChannelStats& s = stats_[channel];
+  if (step.out_of_order) ++s.out_of_order;
+  if (step.release_held) ++s.time_jumps;
+  if (step.dropped_held) {
+    ++s.stamp_outliers;
+    if (s.stamp_outliers <= 3) {
+      spdlog::warn("{}: a message stamped far from its neighbours was dropped", channel);
+    }
   }
-  if (s.received > 0 && utime < s.last_utime && !accept_out_of_order) {
-    ++s.out_of_order;
-    return false;
-  }
+}
+
+void Bus::delivered(const std::string& channel, int64_t utime) {
+  ChannelStats& s = stats_[channel];
   s.last_utime = utime;
   ++s.received;
-  return true;
+}
+
+void Bus::reject(const std::string& channel, const std::string& why) {
+  ChannelStats& s = stats_[channel];
+  ++s.rejected;
+  if (s.rejected <= 3) spdlog::warn("{}: message rejected: {}", channel, why);
 }
 
 void Bus::Subscription::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& ch) {
@@ -125,7 +150,7 @@ void Bus::Subscription::on_message(const lcm::ReceiveBuffer* rbuf, const std::st
   }
   // The receive thread: queue a copy for handle().
   std::lock_guard lock(bus->mutex_);
-  if (bus->queued_bytes_ + size > kMaxQueuedBytes) {
+  if (bus->queued_bytes_ + size > bus->input_.max_queue_bytes) {
     ++bus->queue_dropped_;
   } else {
     bus->queue_.push_back({this, ch, std::vector<uint8_t>(data, data + size), rbuf->recv_utime});

@@ -1,64 +1,95 @@
-// Typed publish/subscribe over LCM with the checks every process needs: a message that does not
-// decode is counted and dropped; one whose utime goes backwards is counted and dropped; skipped
-// sequence numbers are counted; a handler that throws is reported and counted, and the process
-// keeps running.
+// Typed publish/subscribe over LCM with the checks every process needs, so that every consumer
+// gets them: a message whose bytes do not hold what it claims is counted as a decode failure and
+// dropped before anything is allocated for it (message_layout.hpp); one that decodes but cannot be
+// right (message_checks.hpp) or exceeds a limit (a scan's beam cap, input_config.hpp) is counted
+// as rejected and dropped; one whose utime goes backwards is counted and dropped, and one stamped
+// far from its neighbours is held back and then either delivered or dropped as an outlier, never
+// blocking the channel (stamp_order.hpp); skipped sequence numbers are counted; a handler that
+// throws is reported and counted, and the process keeps running.
+//
+// Memory: a message reaches a handler only when its bytes hold everything it claims, so decoding
+// it costs at most a small multiple of its size; the receive queue holds at most
+// input.max_queue_bytes (1 GiB by default).
 //
 // On a network bus (udpm://) a receive thread reads the socket all the time and queues what
 // arrives in memory; handle() dispatches the queued messages, in order, on the calling thread,
 // where every handler runs. A process busy for seconds (a loop closure, an optimisation) so loses
 // nothing to its socket's receive buffer: every process's socket gets every channel of the group,
 // and net.core.rmem_max (8 MB here) holds about two seconds of a whole graph's traffic. Messages
-// beyond kMaxQueuedBytes (1 GiB) queued are dropped and counted. On memq:// (in process) there
+// beyond input.max_queue_bytes queued are dropped and counted. On memq:// (in process) there
 // is no socket: handle() dispatches as LCM delivers, on the calling thread.
 #pragma once
-
-#include <lcm/lcm-cpp.hpp>
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <lcm/lcm-cpp.hpp>
 #include <list>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "input_config.hpp"
+#include "message_checks.hpp"
 #include "publisher.hpp"
+#include "stamp_order.hpp"
 
 namespace traverse {
 
 // Default URL: loopback multicast, never leaves the host (ttl=0), with a receive buffer large
-// enough for bursts of 43 KB scans. Overridden by --lcm-url or LCM_DEFAULT_URL.
+// enough for bursts of 43 KB scans. --lcm-url overrides it; LCM_DEFAULT_URL does not (see
+// process.hpp).
 inline constexpr const char* kDefaultLcmUrl =
     "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
 
 class Bus : public Publisher {
  public:
-  explicit Bus(const std::string& url);
+  explicit Bus(const std::string& url, const InputConfig& input = {});
   bool good() const { return lcm_.good(); }
   const std::string& url() const { return url_; }
+  const InputConfig& input() const { return input_; }
 
-  // Calls handler(msg) for every message on `channel` that decodes as T. Messages whose utime is
-  // earlier than the previous one on the channel are dropped unless `accept_out_of_order`.
+  // Calls handler(msg) for every message on `channel` that decodes as T, passes the checks above
+  // and is in order by its utime (any order if `accept_out_of_order`).
   template <class T>
   void subscribe(const std::string& channel, std::function<void(const T&)> handler,
                  bool accept_out_of_order = false) {
-    add_subscription(channel, true,
-                     [this, channel, accept_out_of_order, handler = std::move(handler)](
-                         const std::string&, const uint8_t* data, int size, int64_t) {
-                       T msg;
-                       if (msg.decode(data, 0, size) != size) return Outcome::kDecodeFailure;
-                       int64_t seq = -1;
-                       if constexpr (requires { msg.seq; }) seq = msg.seq;
-                       if (!admit(channel, msg.utime, seq, accept_out_of_order)) {
-                         return Outcome::kOutOfOrder;
-                       }
-                       handler(msg);
-                       return Outcome::kHandled;
-                     });
+    auto order = std::make_shared<StampOrder>(max_stamp_jump_us());
+    auto held = std::make_shared<std::optional<T>>();
+    add_subscription(
+        channel, true,
+        [this, channel, order, held, accept_out_of_order, handler = std::move(handler)](
+            const std::string&, const uint8_t* data, int size, int64_t) {
+          T msg;
+          const Inspection r = decode_checked(data, size, limits_, msg);
+          if (r.verdict == MessageVerdict::kMalformed) return Outcome::kDecodeFailure;
+          if (r.verdict != MessageVerdict::kGood) {
+            reject(channel, r.problem);
+            return Outcome::kRejected;
+          }
+          int64_t seq = -1;
+          if constexpr (requires { msg.seq; }) seq = msg.seq;
+          count_sequence(channel, seq);
+          const StampOrder::Step step =
+              accept_out_of_order ? StampOrder::Step{.deliver = true} : order->next(msg.utime);
+          count_order(channel, step);
+          if (step.release_held) {
+            const T earlier = std::move(**held);
+            held->reset();
+            delivered(channel, earlier.utime);
+            handler(earlier);
+          }
+          if (step.hold) *held = std::move(msg);
+          if (!step.deliver) return step.out_of_order ? Outcome::kOutOfOrder : Outcome::kHandled;
+          delivered(channel, msg.utime);
+          handler(msg);
+          return Outcome::kHandled;
+        });
     stats_[channel];  // list the channel in status even before the first message
   }
 
@@ -79,7 +110,6 @@ class Bus : public Publisher {
   // was full (both 0 on memq://).
   int64_t queue_max_bytes() const;
   int64_t queue_dropped() const;
-  static constexpr int64_t kMaxQueuedBytes = int64_t{1} << 30;
 
   lcm::LCM& lcm() { return lcm_; }
   ~Bus() override;
@@ -89,7 +119,7 @@ class Bus : public Publisher {
             int64_t utime) override;
 
  private:
-  enum class Outcome { kHandled, kDecodeFailure, kOutOfOrder };
+  enum class Outcome { kHandled, kDecodeFailure, kRejected, kOutOfOrder };
   using Dispatch = std::function<Outcome(const std::string& channel, const uint8_t*, int, int64_t)>;
   struct Subscription {
     Bus* bus = nullptr;
@@ -111,10 +141,16 @@ class Bus : public Publisher {
   void deliver(Subscription& sub, const std::string& channel, const uint8_t* data, int size,
                int64_t recv_utime);
   void read_loop();  // the receive thread of a network bus
-  // Updates sequence and order counters; false if the message must be dropped.
-  bool admit(const std::string& channel, int64_t utime, int64_t seq, bool accept_out_of_order);
+  // Counters of the typed subscriptions.
+  void count_sequence(const std::string& channel, int64_t seq);
+  void count_order(const std::string& channel, const StampOrder::Step& step);
+  void delivered(const std::string& channel, int64_t utime);
+  void reject(const std::string& channel, const std::string& why);
+  int64_t max_stamp_jump_us() const;
 
   std::string url_;
+  InputConfig input_;
+  std::vector<ArrayLimit> limits_;
   lcm::LCM lcm_;
   std::list<std::unique_ptr<Subscription>> subscriptions_;
   const bool threaded_;  // network bus: a receive thread queues messages

@@ -13,7 +13,24 @@ std::string type_name_of(const YAML::Node& n) {
 }
 
 void Reader::check_is_mapping() const {
-  if (node_.IsNull() || node_.IsMap()) return;  // null: empty file or section, all defaults
+  if (node_.IsNull()) return;  // empty file or section: all defaults
+  if (node_.IsMap()) {
+    // YAML forbids a key twice in one mapping, but the parser keeps both and a look-up finds the
+    // first: the second would be ignored without a word.
+    std::vector<std::string> seen;
+    for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) {
+        throw ConfigError(file_ + ": " + (prefix_.empty() ? std::string("top level") : prefix_) +
+                          " has a key that is not a name but " + type_name_of(kv.first));
+      }
+      const std::string key = kv.first.Scalar();
+      if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+        throw ConfigError(file_ + ": key '" + prefix_ + key + "' appears twice");
+      }
+      seen.push_back(key);
+    }
+    return;
+  }
   throw ConfigError(file_ + ": " + (prefix_.empty() ? std::string("top level") : prefix_) +
                     " must be a mapping of keys, got " + type_name_of(node_));
 }

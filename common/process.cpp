@@ -1,6 +1,7 @@
 #include "process.hpp"
 
 #include <signal.h>
+#include <spdlog/spdlog.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -8,9 +9,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
-
 #include <lcm/lcm-cpp.hpp>
-#include <spdlog/spdlog.h>
 
 #include "channels.hpp"
 #include "lcm_log.hpp"
@@ -26,7 +25,8 @@ void on_stop_signal(int) { g_stop = true; }
 double cpu_seconds() {
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec +
+         1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
 int64_t resident_bytes() {
@@ -44,6 +44,29 @@ std::string host_name() {
 
 }  // namespace
 
+LcmUrlChoice choose_lcm_url(const std::string& cli_url, const char* env_url) {
+  LcmUrlChoice c;
+  if (!cli_url.empty()) {
+    c.url = cli_url;
+  } else if (env_url && *env_url) {
+    c.url = env_url;
+    c.note = "LCM URL " + c.url + " from LCM_DEFAULT_URL (not the built-in " + kDefaultLcmUrl +
+             "; --lcm-url overrides both)";
+  } else {
+    c.url = kDefaultLcmUrl;
+  }
+  // LCM's udpm sends with ttl 0 (this host only) unless the URL says otherwise.
+  const auto at = c.url.find("ttl=");
+  if (c.url.rfind("udpm://", 0) == 0 && at != std::string::npos) {
+    const std::string ttl = c.url.substr(at + 4, c.url.find('&', at) - at - 4);
+    if (ttl != "0") {
+      if (!c.note.empty()) c.note += "; ";
+      c.note += "ttl=" + ttl + ": messages leave this host";
+    }
+  }
+  return c;
+}
+
 int64_t now_utime() {
   using namespace std::chrono;
   return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
@@ -52,7 +75,7 @@ int64_t now_utime() {
 bool stop_requested() { return g_stop; }
 
 void install_stop_signals() {
-  struct sigaction sa{};
+  struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
@@ -62,9 +85,9 @@ void install_stop_signals() {
 Process::Process(std::string name, std::string description)
     : name_(std::move(name)), app_(std::move(description), "traverse-" + name_) {
   app_.add_option("--config", config_path_, "YAML config file (defaults apply to absent keys)");
-  const char* env_url = std::getenv("LCM_DEFAULT_URL");
-  lcm_url_ = env_url && *env_url ? env_url : kDefaultLcmUrl;
-  app_.add_option("--lcm-url", lcm_url_, "LCM provider URL")->capture_default_str();
+  app_.add_option("--lcm-url", lcm_url_,
+                  std::string("LCM provider URL (default: LCM_DEFAULT_URL if set, else ") +
+                      kDefaultLcmUrl + ")");
   app_.add_option("--name", name_, "instance name; status goes to STATUS_<NAME>")
       ->capture_default_str();
 }
@@ -118,12 +141,25 @@ void Process::report_config_error(const ConfigError& e) const {
 }
 
 std::optional<int> Process::connect() {
-  if (replaying()) lcm_url_ = "memq://";
-  bus_ = std::make_unique<Bus>(lcm_url_);
+  if (replaying()) {
+    lcm_url_ = "memq://";
+  } else {
+    const LcmUrlChoice choice = choose_lcm_url(lcm_url_, std::getenv("LCM_DEFAULT_URL"));
+    lcm_url_ = choice.url;
+    if (!choice.note.empty()) spdlog::warn("traverse-{}: {}", name_, choice.note);
+  }
+  bus_ = std::make_unique<Bus>(lcm_url_, input_);
   if (!bus_->good()) {
     spdlog::error("traverse-{}: cannot start LCM with URL '{}'", name_, lcm_url_);
     return 1;
   }
+  beat_ = std::make_unique<StatusBeat>(bus_->lcm(), channels::status_channel(name_),
+                                       [start = start_utime_](process_status_t& st) {
+                                         st.utime = now_utime();
+                                         st.uptime_s = 1e-6 * static_cast<double>(st.utime - start);
+                                         st.cpu_s = cpu_seconds();
+                                         st.rss_bytes = resident_bytes();
+                                       });
   if (!record_path_.empty()) {
     recorder_ = std::make_unique<Recorder>();
     recorder_->log = std::make_unique<lcm::LogFile>(record_path_, "w");
@@ -156,6 +192,7 @@ int Process::replay(const std::function<void()>& tick, const std::function<bool(
     std::optional<LogEvent> ev = reader->next();
     if (!ev) break;
     ++events;
+    counters_["replay_events"] = static_cast<double>(events);
     if (recorder_) recorder_->utime = ev->utime;
     if (bus_->lcm().publish(ev->channel, ev->data.data(),
                             static_cast<unsigned int>(ev->data.size())) != 0) {
@@ -173,6 +210,9 @@ int Process::replay(const std::function<void()>& tick, const std::function<bool(
                  d.what, d.offset, d.skipped_bytes);
   }
   spdlog::info("traverse-{}: replayed {} events of {}", name_, events, replay_path_);
+  // In the status, so that a run's verdict sees what the input lost (and an empty input).
+  counters_["replay_events"] = static_cast<double>(events);
+  counters_["replay_damaged_records"] = static_cast<double>(reader->damage().size());
   publish_status("stopping");
   drain();
   return 0;
@@ -181,6 +221,7 @@ int Process::replay(const std::function<void()>& tick, const std::function<bool(
 int Process::spin(const std::function<void()>& tick, const std::function<bool()>& until) {
   if (replaying()) return replay(tick, until);
   publish_status("running");
+  beat_->start();
   int rc = 0;
   while (!g_stop && !(until && until())) {
     if (!bus_->handle(100)) {
@@ -192,6 +233,7 @@ int Process::spin(const std::function<void()>& tick, const std::function<bool()>
     if (tick) tick();
     maybe_publish_status();
   }
+  beat_->stop();
   publish_status("stopping");
   return rc;
 }
@@ -201,7 +243,7 @@ void Process::maybe_publish_status() {
 }
 
 void Process::publish_status(const std::string& state) {
-  if (!bus_) return;
+  if (!bus_ || !beat_) return;
   process_status_t st;
   st.utime = now_utime();
   last_status_utime_ = st.utime;
@@ -229,13 +271,25 @@ void Process::publish_status(const std::string& state) {
     st.counter_names.push_back(k);
     st.counter_values.push_back(v);
   }
+  // What channel_stats_t has no field for: "<CHANNEL>/rejected" and so on, when not zero.
+  for (const auto& [channel, s] : bus_->stats()) {
+    for (const auto& [what, n] :
+         {std::pair{"rejected", s.rejected}, std::pair{"stamp_outliers", s.stamp_outliers},
+          std::pair{"time_jumps", s.time_jumps}}) {
+      if (n == 0) continue;
+      st.counter_names.push_back(channel + "/" + what);
+      st.counter_values.push_back(static_cast<double>(n));
+    }
+  }
   // The bus's receive queue (network bus): how far handling fell behind, and what it dropped.
   st.counter_names.push_back("receive_queue_max_bytes");
   st.counter_values.push_back(static_cast<double>(bus_->queue_max_bytes()));
   st.counter_names.push_back("receive_queue_dropped");
   st.counter_values.push_back(static_cast<double>(bus_->queue_dropped()));
   st.n_counters = static_cast<int32_t>(st.counter_names.size());
-  bus_->publish(channels::status_channel(name_), st);
+  const int64_t utime = st.utime;
+  const int64_t seq = beat_->send(std::move(st));
+  bus_->note_published(channels::status_channel(name_), utime, seq);
 }
 
 }  // namespace traverse

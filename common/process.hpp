@@ -17,10 +17,16 @@
 // before the next event. OUT receives every input and output message in that order, stamped with
 // the time of the input event being handled, so the next process of the graph can replay it in
 // turn and two replays of the same input give the same output.
+//
+// The LCM URL: --lcm-url wins; without it LCM_DEFAULT_URL from the environment is used, and the
+// process says so at start (and warns when that URL lets messages leave the host, ttl above 0);
+// without either, kDefaultLcmUrl (loopback only, ttl=0).
+//
+// Every config file may hold, beside the process's own keys, an `input:` section: the checks the
+// bus makes on every message the process subscribes to (input_config.hpp).
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -30,13 +36,23 @@
 
 #include "bus.hpp"
 #include "config.hpp"
+#include "status_beat.hpp"
 
 namespace traverse {
 
 // Wall-clock time in microseconds since the epoch.
 int64_t now_utime();
 
-// True once SIGINT or SIGTERM arrived (handlers installed by Process::start or install_stop_signals).
+// The LCM URL a process uses and, when it is not the built-in default, a sentence saying where
+// it came from (and whether it lets messages leave this host).
+struct LcmUrlChoice {
+  std::string url;
+  std::string note;  // empty for the built-in default or an explicit --lcm-url with ttl=0
+};
+LcmUrlChoice choose_lcm_url(const std::string& cli_url, const char* env_url);
+
+// True once SIGINT or SIGTERM arrived (handlers installed by Process::start or
+// install_stop_signals).
 bool stop_requested();
 void install_stop_signals();
 
@@ -57,7 +73,12 @@ class Process {
   std::optional<int> start(int argc, char** argv, Config& config, bool connect = true) {
     if (auto rc = parse(argc, argv)) return rc;
     try {
-      if (!config_path_.empty()) load_config(config_path_, config);
+      if (!config_path_.empty()) {
+        WithInput<Config> both{config, input_};
+        load_config(config_path_, both);
+        if (auto problem = validate_input(input_))
+          throw ConfigError(config_path_ + ": " + *problem);
+      }
     } catch (const ConfigError& e) {
       report_config_error(e);
       return kConfigErrorExitCode;
@@ -73,7 +94,8 @@ class Process {
   double& counter(const std::string& name) { return counters_[name]; }
 
   // Handles messages until a stop signal or `until()` returns true; calls tick() after each
-  // wake-up (at least every 100 ms). Publishes status once a second and a last one when stopping.
+  // wake-up (at least every 100 ms). Publishes status once a second and a last one when stopping;
+  // live, the status keeps beating while a step takes longer (status_beat.hpp).
   // Returns 0, or 1 if LCM failed.
   int spin(const std::function<void()>& tick = {}, const std::function<bool()>& until = {});
 
@@ -85,6 +107,17 @@ class Process {
   void maybe_publish_status();
 
  private:
+  // A process's config and the `input:` section every process accepts, read from one file.
+  template <class Config>
+  struct WithInput {
+    Config& config;
+    InputConfig& input;
+    template <class V>
+    void visit(V& v) {
+      config.visit(v);
+      v("input", input);
+    }
+  };
   std::optional<int> parse(int argc, char** argv);
   std::optional<int> connect();
   void report_config_error(const ConfigError& e) const;
@@ -95,7 +128,9 @@ class Process {
   CLI::App app_;
   std::string config_path_;
   std::string lcm_url_;
+  InputConfig input_;
   std::unique_ptr<Bus> bus_;
+  std::unique_ptr<StatusBeat> beat_;  // after bus_: stops before the bus goes
   std::string replay_path_;
   std::string record_path_;
   struct Recorder;
@@ -103,7 +138,6 @@ class Process {
   std::map<std::string, double> counters_;
   int64_t start_utime_ = 0;
   int64_t last_status_utime_ = 0;
-  int64_t status_seq_ = 0;
 };
 
 }  // namespace traverse

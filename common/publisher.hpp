@@ -33,6 +33,14 @@ class Publisher {
 
   const ChannelStatsMap& stats() const { return stats_; }
 
+  // Counts a message this process sent on `channel` by other means (its status, StatusBeat).
+  void note_published(const std::string& channel, int64_t utime, int64_t seq) {
+    ChannelStats& s = stats_[channel];
+    ++s.published;
+    s.last_utime = utime;
+    s.last_seq = seq;
+  }
+
  protected:
   // `utime` is the message's own time: a log file uses it as the event time.
   virtual void send(const std::string& channel, const uint8_t* data, std::size_t size,

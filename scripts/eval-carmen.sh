@@ -20,11 +20,6 @@ OFFLINE=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
-usage() {
-  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
-  exit "${1:-2}"
-}
-
 what="" stages="" speed=10
 while (($#)); do
   case "$1" in
@@ -38,30 +33,13 @@ while (($#)); do
 done
 [[ -n $what ]] || usage
 
-data="$(cd "$ROOT/.." && pwd)/shared/data/carmen"
-if [[ -f $what ]]; then
-  input="$(cd "$(dirname "$what")" && pwd)/$(basename "$what")"
-  name="$(basename "$what")"
-  name="${name%.gz}"
-  name="${name%.log}"
-  name="${name%-corrected}"
-elif [[ -f $data/$what-corrected.log.gz ]]; then
-  input="$data/$what-corrected.log.gz"
-  name="$what"
-else
-  die "no CARMEN log '$what' (names: $(cd "$data" 2>/dev/null && ls *-corrected.log.gz | sed 's/-corrected\.log\.gz$//' | tr '\n' ' '))"
-fi
-
+find_carmen_log "$what" "$(cd "$ROOT/.." && pwd)/shared/data/carmen" -corrected.log.gz
+input="$LOG_INPUT" name="$LOG_NAME"
 need_programs traverse-carmen traverse-evaluator
 
 # 1. The log converted to LCM, cached by name.
 cache="$ROOT/out/cache/carmen-$name.lcmlog"
-mkdir -p "$ROOT/out/cache"
-if stale "$cache" "$BIN/traverse-carmen" "$input"; then
-  echo "eval-carmen: converting $input -> $cache" >&2
-  "$BIN/traverse-carmen" "$input" --out "$cache.tmp" >&2 || die "traverse-carmen failed"
-  mv "$cache.tmp" "$cache"
-fi
+convert_carmen_log "$input" "$cache"
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
 out="$ROOT/out/eval/carmen-$name-$(stages_tag "$stages")"

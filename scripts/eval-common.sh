@@ -14,6 +14,12 @@ die() {
   exit 1
 }
 
+# The calling script's header comment (from its second line to `set -euo`) as its usage.
+usage() {
+  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
+  exit "${1:-2}"
+}
+
 # Builds nothing itself: runs scripts/setup.sh only when build/bin is missing, then checks that
 # the named programs are there.
 need_programs() {
@@ -43,6 +49,39 @@ estimate_channel() {
 # "frontend,backend" -> "frontend+backend"; no stage -> "none" (the reference against itself).
 stages_tag() {
   [[ -z $1 ]] && echo none || echo "${1//,/+}"
+}
+
+# find_carmen_log WHAT DIR SUFFIX: WHAT is a CARMEN log file, or a name with DIR/WHAT$SUFFIX.
+# Sets LOG_INPUT (absolute path) and LOG_NAME (the name, or the file's without .gz, .log and
+# -corrected).
+find_carmen_log() {
+  local what="$1" dir="$2" suffix="$3"
+  if [[ -f $what ]]; then
+    LOG_INPUT="$(cd "$(dirname "$what")" && pwd)/$(basename "$what")"
+    LOG_NAME="$(basename "$what")"
+    LOG_NAME="${LOG_NAME%.gz}"
+    LOG_NAME="${LOG_NAME%.log}"
+    LOG_NAME="${LOG_NAME%-corrected}"
+  elif [[ -f $dir/$what$suffix ]]; then
+    LOG_INPUT="$dir/$what$suffix"
+    LOG_NAME="$what"
+  else
+    die "no CARMEN log '$what' (names: $(cd "$dir" 2>/dev/null && ls ./*"$suffix" | sed "s|^\./||; s|$suffix\$||" | tr '\n' ' '))"
+  fi
+}
+
+# convert_carmen_log INPUT CACHE: the log converted by traverse-carmen into CACHE (an LCM log),
+# again only when the program or the input is newer; the driver's summary JSON in CACHE.json.
+convert_carmen_log() {
+  local input="$1" cache="$2"
+  mkdir -p "$(dirname "$cache")"
+  if stale "$cache" "$BIN/traverse-carmen" "$input" || [[ ! -s $cache.json ]]; then
+    echo "$(basename "$0"): converting $input -> $cache" >&2
+    "$BIN/traverse-carmen" "$input" --out "$cache.tmp" >"$cache.out" 2>&1 ||
+      { tail -n 5 "$cache.out" >&2; die "traverse-carmen failed, see $cache.out"; }
+    last_json_line "$cache.out" >"$cache.json"
+    mv "$cache.tmp" "$cache"
+  fi
 }
 
 # True when $1 is missing or older than any of the other files.
@@ -88,6 +127,26 @@ run_graph() {
   [[ -s $out/run.lcmlog ]] || die "run-graph wrote no $out/run.lcmlog"
 }
 
+# check_stage_poses LOG STAGES: fails the run when a stage of the list published nothing or a
+# single pose on its trajectory channel (a stage that died quietly, or a log whose stamps carried
+# no time, must not reach the evaluator as a short "perfect" run). Counts from traverse-validate.
+check_stage_poses() {
+  local log="$1" stages="$2" counts
+  [[ -x $BIN/traverse-validate ]] || die "$BIN/traverse-validate not found (build it: scripts/setup.sh)"
+  counts="$("$BIN/traverse-validate" --json-only "$log" 2>/dev/null | tail -n 1)" || true
+  [[ $counts == \{*\} ]] || die "traverse-validate could not read $log"
+  python3 - "$stages" "$counts" <<'PY' || die "a stage published too little (see above)"
+import json, sys
+stages, counts = sys.argv[1].split(","), json.loads(sys.argv[2])["channels"]
+channels = {"frontend": "POSE_FRONTEND", "backend": "POSE_BACKEND", "densifier": "POSE_DENSE"}
+bad = [(s, channels[s], counts.get(channels[s], {}).get("count", 0)) for s in stages
+       if s in channels and counts.get(channels[s], {}).get("count", 0) < 2]
+for stage, channel, n in bad:
+    print(f"stage {stage} published {n} pose(s) on {channel}: the run failed", file=sys.stderr)
+sys.exit(1 if bad else 0)
+PY
+}
+
 # The last line of a file if it is a JSON object, else nothing.
 last_json_line() {
   local line
@@ -119,6 +178,7 @@ run_and_evaluate() {
     evaluate "$in" "$ref" "$ref" "$out"
   else
     run_graph "$in" "$out" "$stages" "$speed"
+    check_stage_poses "$out/run.lcmlog" "$stages"
     evaluate "$out/run.lcmlog" "$(estimate_channel "$stages")" "$ref" "$out"
   fi
 }

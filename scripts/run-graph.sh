@@ -8,7 +8,11 @@
 #
 # Records every channel into OUTDIR/run.lcmlog, the monitor's summary into OUTDIR/monitor.json and
 # each process's output into OUTDIR/<name>.log, and its own summary (JSON line last on stdout) into
-# OUTDIR/run-graph.json. Exits non-zero if a process died (it says which); 130 after Ctrl-C.
+# OUTDIR/run-graph.json. Exits 1 if a process died (it says which), 3 if the run's verdict fails
+# (the input log is damaged or empty, or the monitor -- configs/monitor.yaml -- found messages
+# missed, dropped, out of order or rejected, or a process stalled), 130 after Ctrl-C; offline
+# (--offline) the monitor judges the recorded run afterwards. net.core.rmem_max is only raised
+# with --raise-rmem-max (as root; it is system-wide), otherwise said when it is too small.
 # Programs come from build/bin (or $TRAVERSE_BIN_DIR); relative config paths in the deployment
 # file are taken from the repository root.
 set -euo pipefail

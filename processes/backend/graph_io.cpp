@@ -1,7 +1,9 @@
 #include "graph_io.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <unordered_map>
 #include <vector>
@@ -69,6 +71,10 @@ GraphReadResult read_pose_graph(std::istream& in, const std::string& name) {
       p.edge.information = tag == "EDGE_SE2" ? symmetric(v[3], v[4], v[5], v[6], v[7], v[8])
                                              : symmetric(v[3], v[4], v[7], v[5], v[8], v[6]);
       if (!p.edge.information.allFinite()) return fail(line, "information is not finite");
+      if (!positive_definite(p.edge.information)) {
+        return fail(line, "information matrix of edge " + std::to_string(p.from) + " -> " +
+                              std::to_string(p.to) + " is not positive definite");
+      }
       p.line = line;
       pending.push_back(p);
     } else if (tag == "FIX") {
@@ -79,6 +85,20 @@ GraphReadResult read_pose_graph(std::istream& in, const std::string& name) {
       return fail(line, "unsupported record '" + tag +
                             "' (expected VERTEX_SE2, EDGE_SE2, FIX, "
                             "VERTEX2 or EDGE2)");
+    }
+  }
+  if (graph.poses.empty() && pending.empty()) {
+    result.error = name + ": no vertices and no edges (an empty file?)";
+    return result;
+  }
+  // Edges alone: a vertex per id named, in id order, placed later along a spanning tree.
+  const bool from_edges = graph.poses.empty();
+  if (from_edges) {
+    std::map<int64_t, bool> ids;
+    for (const PendingEdge& p : pending) ids[p.from] = ids[p.to] = true;
+    for (const auto& [id, unused] : ids) {
+      index.emplace(id, static_cast<int>(graph.poses.size()));
+      graph.add_vertex(id, Pose2());
     }
   }
   for (PendingEdge& p : pending) {
@@ -100,6 +120,8 @@ GraphReadResult read_pose_graph(std::istream& in, const std::string& name) {
     }
     graph.fixed[it->second] = true;
   }
+  if (from_edges) initialise_from_edges(graph);
+  result.initialised_from_edges = from_edges;
   result.graph = std::move(graph);
   return result;
 }

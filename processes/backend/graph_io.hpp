@@ -6,7 +6,11 @@
 // TORO: VERTEX2 id x y theta
 //       EDGE2 i j dx dy dtheta I11 I12 I22 I33 I13 I23
 // Lengths in metres, angles in radians. Blank lines and lines starting with '#' are skipped; any
-// other unknown or malformed line is an error naming the file and line number.
+// other unknown or malformed line is an error naming the file and line number, and so is an
+// information matrix that is not symmetric positive definite (it would make the optimiser report
+// convergence with poses kilometres away). A file with edges but no vertex lines at all (the
+// SE-Sync benchmark graphs) gets a vertex per id, initialised by composing the edges along a
+// spanning tree; an empty file is an error.
 #pragma once
 
 #include <iosfwd>
@@ -18,8 +22,9 @@
 namespace traverse::backend {
 
 struct GraphReadResult {
-  std::optional<PoseGraph> graph;  // empty on error
-  std::string error;               // "FILE:LINE: what is wrong" when graph is empty
+  std::optional<PoseGraph> graph;       // empty on error
+  std::string error;                    // "FILE:LINE: what is wrong" when graph is empty
+  bool initialised_from_edges = false;  // no vertex lines: poses composed along a spanning tree
 };
 
 // Reads a g2o or TORO file (the record tags decide; both may be mixed). Vertex ids may be

@@ -1,6 +1,8 @@
 #include "pose_graph.hpp"
 
+#include <Eigen/Cholesky>
 #include <cmath>
+#include <queue>
 
 namespace traverse::backend {
 
@@ -19,11 +21,80 @@ int PoseGraph::index_of(int64_t id) const {
 }
 
 void PoseGraph::fix_gauge_if_free() {
-  if (poses.empty()) return;
-  for (bool f : fixed) {
-    if (f) return;
+  int count = 0;
+  const std::vector<int> component = components(*this, &count);
+  std::vector<bool> has_fixed(count, false);
+  for (std::size_t v = 0; v < poses.size(); ++v) {
+    if (fixed[v]) has_fixed[component[v]] = true;
   }
-  fixed[0] = true;
+  for (std::size_t v = 0; v < poses.size(); ++v) {
+    if (!has_fixed[component[v]]) {
+      fixed[v] = true;
+      has_fixed[component[v]] = true;
+    }
+  }
+}
+
+namespace {
+
+// For every vertex, the edges that touch it (edge indices).
+std::vector<std::vector<int>> incident_edges(const PoseGraph& graph) {
+  std::vector<std::vector<int>> incident(graph.poses.size());
+  for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+    incident[graph.edges[k].from].push_back(static_cast<int>(k));
+    incident[graph.edges[k].to].push_back(static_cast<int>(k));
+  }
+  return incident;
+}
+
+// Breadth-first search from every unvisited vertex in index order; visit(edge, from, to) for each
+// tree edge, `from` already reached.
+template <class Visit>
+std::vector<int> spanning_forest(const PoseGraph& graph, int* count, Visit visit) {
+  const auto incident = incident_edges(graph);
+  std::vector<int> component(graph.poses.size(), -1);
+  int next = 0;
+  for (std::size_t root = 0; root < graph.poses.size(); ++root) {
+    if (component[root] >= 0) continue;
+    std::queue<int> open;
+    open.push(static_cast<int>(root));
+    component[root] = next;
+    while (!open.empty()) {
+      const int v = open.front();
+      open.pop();
+      for (int k : incident[v]) {
+        const Edge& e = graph.edges[k];
+        const int w = e.from == v ? e.to : e.from;
+        if (component[w] >= 0) continue;
+        component[w] = next;
+        visit(e, v, w);
+        open.push(w);
+      }
+    }
+    ++next;
+  }
+  if (count) *count = next;
+  return component;
+}
+
+}  // namespace
+
+std::vector<int> components(const PoseGraph& graph, int* count) {
+  return spanning_forest(graph, count, [](const Edge&, int, int) {});
+}
+
+void initialise_from_edges(PoseGraph& graph) {
+  spanning_forest(graph, nullptr, [&graph](const Edge& e, int from, int to) {
+    // T_world_to = T_world_from Z along the edge, or T_world_from Z^-1 against it.
+    graph.poses[to] = e.from == from ? graph.poses[from] * e.T_from_to
+                                     : graph.poses[from] * e.T_from_to.inverse();
+  });
+}
+
+bool positive_definite(const Eigen::Matrix3d& information) {
+  if (!information.allFinite() || !information.isApprox(information.transpose())) return false;
+  Eigen::LLT<Eigen::Matrix3d> llt(information);
+  return llt.info() == Eigen::Success;
 }
 
 Eigen::Vector3d edge_error(const Pose2& T_world_i, const Pose2& T_world_j, const Pose2& Z) {

@@ -35,9 +35,22 @@ struct PoseGraph {
   int add_vertex(int64_t id, const Pose2& T_world_vertex, bool is_fixed = false);
   // Index of a vertex id, or -1.
   int index_of(int64_t id) const;
-  // Fixes the first vertex when no vertex is fixed (the gauge of SPA).
+  // Fixes the first vertex of every connected component that has no fixed vertex (the gauge of
+  // SPA: a component left free makes H singular).
   void fix_gauge_if_free();
 };
+
+// The connected component of every vertex (0, 1, ... in order of their first vertex), through
+// the edges in either direction; `count` is set to the number of components.
+std::vector<int> components(const PoseGraph& graph, int* count = nullptr);
+
+// Sets every vertex's pose by composing the edges along a spanning tree (breadth first from the
+// first vertex of each component, which stays where it is): the initial guess for a graph given
+// by its edges alone.
+void initialise_from_edges(PoseGraph& graph);
+
+// True when a 3x3 information matrix is symmetric positive definite (its Cholesky exists).
+bool positive_definite(const Eigen::Matrix3d& information);
 
 // e = t2v(Z^-1 (Xi^-1 Xj)) of one edge, given the two vertex poses.
 Eigen::Vector3d edge_error(const Pose2& T_world_i, const Pose2& T_world_j, const Pose2& Z);

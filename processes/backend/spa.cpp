@@ -111,6 +111,17 @@ double SpaOptimizer::apply_step(const std::vector<Pose2>& poses, const Eigen::Ve
 
 SpaResult SpaOptimizer::optimize(PoseGraph& graph) {
   SpaResult result;
+  // An information matrix that is not positive definite rewards error along some direction: the
+  // optimiser would "converge" with poses kilometres away.
+  for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+    const Edge& e = graph.edges[k];
+    if (!positive_definite(e.information)) {
+      result.termination = "edge " + std::to_string(k) + " (" + std::to_string(graph.ids[e.from]) +
+                           " -> " + std::to_string(graph.ids[e.to]) +
+                           ") has an information matrix that is not positive definite";
+      return result;
+    }
+  }
   prepare(graph);
   Eigen::VectorXd b, dx;
   double chi2_now = linearize(graph, graph.poses, b);

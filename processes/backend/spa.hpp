@@ -5,10 +5,12 @@
 // Each iteration solves (H + lambda diag(H)) dx = -b, H = sum J^T Omega J, b = sum J^T Omega e, and
 // updates the damping by the gain ratio as in Nielsen (1999) / Madsen, Nielsen & Tingleff,
 // "Methods for non-linear least squares problems" (2004), section 3.2. The first vertex (or the
-// vertices marked fixed) is held constant, which fixes the gauge. It stops on convergence (relative
-// chi2 decrease, step size, or gradient below tolerance), not on an iteration count; the cap is
-// only a guard and reaching it is reported as not converged. A step whose cost is NaN or infinite
-// is rejected like any other failed step, so the state always stays the last good one.
+// vertices marked fixed) of each connected component is held constant, which fixes the gauge; an
+// edge whose information matrix is not positive definite stops it before the first step. It stops
+// on convergence (relative chi2 decrease, step size, or gradient below tolerance), not on an
+// iteration count; the cap is only a guard and reaching it is reported as not converged. A step
+// whose cost is NaN or infinite is rejected like any other failed step, so the state always stays
+// the last good one.
 #pragma once
 
 #include <Eigen/Core>
@@ -62,12 +64,13 @@ class SpaOptimizer {
   // The config must pass validate().
   explicit SpaOptimizer(SpaConfig config = {});
 
-  // Optimises graph.poses in place (fixes the first vertex if none is fixed).
+  // Optimises graph.poses in place (fixes the first vertex of every component with none fixed).
   SpaResult optimize(PoseGraph& graph);
 
   // Marginal covariance of every vertex at the current poses, in the world frame on
   // (x [m], y [m], theta [rad]): the 3x3 diagonal blocks of H^-1 recovered from the sparse
-  // Cholesky factor (see marginals.hpp). Fixed vertices get zero. Empty if H is singular.
+  // Cholesky factor (see marginals.hpp), each relative to its component's fixed vertex (nothing
+  // relates two components). Fixed vertices get zero. Empty if H is singular.
   std::optional<std::vector<Eigen::Matrix3d>> marginals(PoseGraph& graph);
 
   const BlockCholesky& system() const { return system_; }

@@ -7,12 +7,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "seconds_text.hpp"
+
 namespace traverse::carmen {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Timestamps beyond this are not seconds since any epoch a robot log could have [s].
-constexpr double kMaxTimestampS = 1e11;
 
 std::vector<std::string_view> split(std::string_view s) {
   std::vector<std::string_view> out;
@@ -63,30 +63,37 @@ bool read_ranges(const std::vector<std::string_view>& t, std::size_t first, int 
   return true;
 }
 
-// Reads x y theta at `first`; false unless all three are finite.
-bool read_pose(const std::vector<std::string_view>& t, std::size_t first, Scan& scan) {
+struct Xyt {
+  double x = 0.0, y = 0.0, theta = 0.0;  // [m], [m], [rad]
+};
+
+// Reads x y theta at `first`; nullopt unless all three are finite.
+std::optional<Xyt> read_pose(const std::vector<std::string_view>& t, std::size_t first) {
   const auto x = to_number(t[first]), y = to_number(t[first + 1]), th = to_number(t[first + 2]);
-  if (!x || !y || !th) return false;
-  scan.x_m = *x;
-  scan.y_m = *y;
-  scan.theta_rad = *th;
+  if (!x || !y || !th) return std::nullopt;
+  return Xyt{*x, *y, *th};
+}
+
+// The ipc timestamp at `ipc` and the logger timestamp at `logger`. A bad ipc timestamp makes the
+// line malformed; the logger timestamp is optional information, a bad one is left out.
+bool read_stamp(const std::vector<std::string_view>& t, std::size_t ipc, std::size_t logger,
+                Stamp& stamp) {
+  const auto ipc_utime = seconds_text_to_utime(t[ipc]);
+  if (!ipc_utime) return false;
+  stamp.ipc_utime = *ipc_utime;
+  stamp.ipc_quantum_s = printed_quantum(t[ipc]);
+  stamp.logger_utime = seconds_text_to_utime(t[logger]);
+  if (stamp.logger_utime) stamp.logger_quantum_s = printed_quantum(t[logger]);
   return true;
 }
 
-bool read_timestamp(std::string_view tok, Scan& scan) {
-  const auto ts = to_number(tok);
-  if (!ts || std::abs(*ts) > kMaxTimestampS) return false;
-  scan.utime = std::llround(*ts * 1e6);
-  scan.utime_quantum_s = printed_quantum(tok);
-  return true;
-}
-
-// The logger timestamp is optional information: a bad one is ignored, not a malformed line.
-void read_logger_timestamp(std::string_view tok, Scan& scan) {
-  const auto ts = to_number(tok);
-  if (!ts || std::abs(*ts) > kMaxTimestampS) return;
-  scan.logger_utime = std::llround(*ts * 1e6);
-  scan.logger_quantum_s = printed_quantum(tok);
+void set_poses(const Xyt& laser, const Xyt& odometry, Scan& scan) {
+  scan.x_m = laser.x;
+  scan.y_m = laser.y;
+  scan.theta_rad = laser.theta;
+  scan.odom_x_m = odometry.x;
+  scan.odom_y_m = odometry.y;
+  scan.odom_theta_rad = odometry.theta;
 }
 
 ParsedLine parse_flaser(const std::vector<std::string_view>& t, int64_t line,
@@ -105,9 +112,13 @@ ParsedLine parse_flaser(const std::vector<std::string_view>& t, int64_t line,
   scan.line = line;
   scan.beams = flaser_beam_angles(*n, geometry);
   if (!read_ranges(t, 2, *n, scan.ranges)) return Malformed{"FLASER: bad range"};
-  if (!read_pose(t, 2 + *n, scan)) return Malformed{"FLASER: bad pose"};
-  if (!read_timestamp(t[2 + *n + 6], scan)) return Malformed{"FLASER: bad timestamp"};
-  read_logger_timestamp(t[2 + *n + 8], scan);
+  const auto pose = read_pose(t, 2 + *n), odom = read_pose(t, 2 + *n + 3);
+  if (!pose || !odom) return Malformed{"FLASER: bad pose"};
+  if (!read_stamp(t, 2 + *n + 6, 2 + *n + 8, scan.stamp)) {
+    return Malformed{"FLASER: bad timestamp"};
+  }
+  scan.utime = scan.stamp.ipc_utime;
+  set_poses(*pose, *odom, scan);
   return scan;
 }
 
@@ -133,10 +144,39 @@ ParsedLine parse_robotlaser1(const std::vector<std::string_view>& t, int64_t lin
   scan.beams = {*start, *res};
   scan.range_max_m = *max_range;
   if (!read_ranges(t, 9, *n, scan.ranges)) return Malformed{"ROBOTLASER1: bad range"};
-  if (!read_pose(t, at_pose, scan)) return Malformed{"ROBOTLASER1: bad laser pose"};
-  if (!read_timestamp(t[at_pose + 11], scan)) return Malformed{"ROBOTLASER1: bad timestamp"};
-  read_logger_timestamp(t[at_pose + 13], scan);
+  const auto pose = read_pose(t, at_pose), robot = read_pose(t, at_pose + 3);
+  if (!pose) return Malformed{"ROBOTLASER1: bad laser pose"};
+  if (!robot) return Malformed{"ROBOTLASER1: bad robot pose"};
+  const auto tv = to_number(t[at_pose + 6]), rv = to_number(t[at_pose + 7]);
+  if (!tv || !rv) return Malformed{"ROBOTLASER1: bad velocity"};
+  if (!read_stamp(t, at_pose + 11, at_pose + 13, scan.stamp)) {
+    return Malformed{"ROBOTLASER1: bad timestamp"};
+  }
+  scan.utime = scan.stamp.ipc_utime;
+  set_poses(*pose, *robot, scan);
+  scan.tv_mps = *tv;
+  scan.rv_radps = *rv;
   return scan;
+}
+
+// ODOM x y theta tv rv accel ipc_timestamp host logger_timestamp
+ParsedLine parse_odom(const std::vector<std::string_view>& t, int64_t line) {
+  if (t.size() != 10) {
+    return Malformed{"ODOM: " + std::to_string(t.size()) + " fields, expected 10"};
+  }
+  Odometry odom;
+  odom.line = line;
+  const auto pose = read_pose(t, 1);
+  const auto tv = to_number(t[4]), rv = to_number(t[5]), accel = to_number(t[6]);
+  if (!pose) return Malformed{"ODOM: bad pose"};
+  if (!tv || !rv || !accel) return Malformed{"ODOM: bad velocity"};
+  if (!read_stamp(t, 7, 9, odom.stamp)) return Malformed{"ODOM: bad timestamp"};
+  odom.x_m = pose->x;
+  odom.y_m = pose->y;
+  odom.theta_rad = pose->theta;
+  odom.tv_mps = *tv;
+  odom.rv_radps = *rv;
+  return odom;
 }
 
 }  // namespace
@@ -188,27 +228,28 @@ ParsedLine parse_line(std::string_view text, int64_t line_number, FlaserGeometry
   if (t.empty() || t[0][0] == '#') return Ignorable{};
   if (t[0] == "FLASER") return parse_flaser(t, line_number, geometry);
   if (t[0] == "ROBOTLASER1") return parse_robotlaser1(t, line_number);
+  if (t[0] == "ODOM") return parse_odom(t, line_number);
   if (!looks_like_type(t[0])) return Malformed{"not a CARMEN message type"};
   return OtherMessage{std::string(t[0])};
 }
 
-struct Reader::GzFile {
+struct LineReader::GzFile {
   gzFile f = nullptr;
   ~GzFile() {
     if (f) gzclose(f);
   }
 };
 
-Reader::Reader(const std::string& path, FlaserGeometry geometry, TimestampPolicy timestamps)
-    : file_(std::make_unique<GzFile>()), geometry_(geometry), timestamps_(timestamps) {
+LineReader::LineReader(const std::string& path, FlaserGeometry geometry)
+    : file_(std::make_unique<GzFile>()), geometry_(geometry) {
   file_->f = gzopen(path.c_str(), "rb");  // reads plain files transparently
   good_ = file_->f != nullptr;
-  if (!good_) summary_.input_error = "cannot open " + path;
+  if (!good_) counts_.input_error = "cannot open " + path;
 }
 
-Reader::~Reader() = default;
+LineReader::~LineReader() = default;
 
-bool Reader::read_line(std::string& line) {
+bool LineReader::read_line(std::string& line) {
   line.clear();
   line_too_long_ = false;
   while (true) {
@@ -232,8 +273,8 @@ bool Reader::read_line(std::string& line) {
       int code = Z_OK;
       const char* msg = gzerror(file_->f, &code);
       if (got < 0 || code != Z_OK) {
-        summary_.input_error = std::string("compressed input damaged after line ") +
-                               std::to_string(summary_.lines) + ": " + (msg ? msg : "?");
+        counts_.input_error = std::string("compressed input damaged after line ") +
+                              std::to_string(counts_.lines) + ": " + (msg ? msg : "?");
       }
       eof_ = true;
       buffer_.clear();
@@ -246,49 +287,31 @@ bool Reader::read_line(std::string& line) {
   }
 }
 
-std::optional<Scan> Reader::next() {
+std::optional<std::variant<Scan, Odometry>> LineReader::next() {
   if (!good_) return std::nullopt;
   std::string text;
   while (read_line(text)) {
-    const int64_t number = ++summary_.lines;
+    const int64_t number = ++counts_.lines;
     ParsedLine parsed = line_too_long_ ? ParsedLine(Malformed{"line longer than 1 MiB"})
                                        : parse_line(text, number, geometry_);
     if (auto* scan = std::get_if<Scan>(&parsed)) {
-      summary_.max_quantum_s = std::max(summary_.max_quantum_s, scan->utime_quantum_s);
-      if (scan->utime_quantum_s > timestamps_.max_quantum_s) {
-        // Too coarse to order or space scans (csail: 404 of 406 scans share two values). The
-        // logger's clock, if printed finely, else the nominal period after the previous scan.
-        ++summary_.quantised_count;
-        if (scan->logger_utime && scan->logger_quantum_s <= timestamps_.max_quantum_s) {
-          scan->utime = *scan->logger_utime;
-          ++summary_.restamped_logger;
-        } else if (last_utime_) {
-          scan->utime = *last_utime_ + std::llround(timestamps_.nominal_period_s * 1e6);
-          ++summary_.restamped_nominal;
-        }
-      }
-      if (last_utime_ && scan->utime <= *last_utime_) {
-        summary_.max_backstep_us = std::max(summary_.max_backstep_us, *last_utime_ - scan->utime);
-        if (summary_.backwards_lines.size() < Summary::kListed) {
-          summary_.backwards_lines.push_back(number);
-        }
-        ++summary_.backwards_count;
-        scan->utime = *last_utime_ + 1;
-      }
-      last_utime_ = scan->utime;
-      ++summary_.scans;
-      ++summary_.scans_by_type[scan->type];
+      ++counts_.scans;
+      ++counts_.scans_by_type[scan->type];
       return std::move(*scan);
     }
+    if (auto* odom = std::get_if<Odometry>(&parsed)) {
+      ++counts_.odometry;
+      return *odom;
+    }
     if (auto* other = std::get_if<OtherMessage>(&parsed)) {
-      ++summary_.skipped_by_type[other->type];
+      ++counts_.skipped_by_type[other->type];
     } else if (auto* bad = std::get_if<Malformed>(&parsed)) {
-      if (summary_.malformed_count++ == 0) summary_.first_malformed_reason = bad->reason;
-      if (summary_.malformed_lines.size() < Summary::kListed) {
-        summary_.malformed_lines.push_back(number);
+      if (counts_.malformed_count++ == 0) counts_.first_malformed_reason = bad->reason;
+      if (counts_.malformed_lines.size() < LineCounts::kListed) {
+        counts_.malformed_lines.push_back(number);
       }
     } else {
-      ++summary_.comment_or_blank_lines;
+      ++counts_.comment_or_blank_lines;
     }
   }
   return std::nullopt;

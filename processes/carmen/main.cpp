@@ -8,19 +8,20 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 
 #include "carmen_config.hpp"
-#include "carmen_log.hpp"
 #include "carmen_node.hpp"
-#include "json_escape.hpp"
+#include "log_reader.hpp"
 #include "process.hpp"
 #include "publisher.hpp"
+#include "summary.hpp"
 
 namespace {
 
-using traverse::carmen::Summary;
+namespace carmen = traverse::carmen;
 
 // --out is known before parsing so that the file mode never needs a working network.
 bool writes_log_file(int argc, char** argv) {
@@ -28,94 +29,6 @@ bool writes_log_file(int argc, char** argv) {
     if (std::strcmp(argv[i], "--out") == 0 || std::strncmp(argv[i], "--out=", 6) == 0) return true;
   }
   return false;
-}
-
-struct RunFacts {
-  int64_t scans_published = 0;
-  int64_t poses_published = 0;
-  int64_t first_utime = 0;
-  int64_t last_utime = 0;
-  double wall_s = 0.0;
-  bool interrupted = false;
-};
-
-void print_summary(const Summary& s, const RunFacts& run, const std::string& out_path,
-                   double nominal_period_s) {
-  std::printf("lines read:        %lld\n", static_cast<long long>(s.lines));
-  for (const auto& [type, n] : s.scans_by_type) {
-    std::printf("scans (%s): %lld\n", type.c_str(), static_cast<long long>(n));
-  }
-  std::printf("scans published:   %lld\nreference poses:   %lld\n",
-              static_cast<long long>(run.scans_published),
-              static_cast<long long>(run.poses_published));
-  std::printf("log time span:     %.3f s\n", 1e-6 * (run.last_utime - run.first_utime));
-  for (const auto& [type, n] : s.skipped_by_type) {
-    std::printf("skipped %-10s %lld lines\n", type.c_str(), static_cast<long long>(n));
-  }
-  std::printf("malformed lines:   %lld%s%s\n", static_cast<long long>(s.malformed_count),
-              s.malformed_count ? ", first: " : "", s.first_malformed_reason.c_str());
-  if (s.backwards_count) {
-    std::printf(
-        "time going back:   %lld scans stamped before the previous one (by up to %.3f s), "
-        "restamped 1 us after it\n",
-        static_cast<long long>(s.backwards_count), 1e-6 * s.max_backstep_us);
-  }
-  if (s.quantised_count) {
-    std::printf(
-        "quantised time:    %lld scans stamped to %.6g s only: %lld restamped from the logger "
-        "timestamp, %lld spaced at the nominal period\n",
-        static_cast<long long>(s.quantised_count), s.max_quantum_s,
-        static_cast<long long>(s.restamped_logger), static_cast<long long>(s.restamped_nominal));
-  }
-  if (!s.input_error.empty()) std::printf("input error:       %s\n", s.input_error.c_str());
-
-  std::string j = "{\"scans\":" + std::to_string(run.scans_published) +
-                  ",\"reference_poses\":" + std::to_string(run.poses_published) +
-                  ",\"lines\":" + std::to_string(s.lines) + ",\"scans_by_type\":{";
-  bool first = true;
-  for (const auto& [type, n] : s.scans_by_type) {
-    j += (first ? "\"" : ",\"") + traverse::json_escape(type) + "\":" + std::to_string(n);
-    first = false;
-  }
-  j += "},\"skipped_by_type\":{";
-  first = true;
-  for (const auto& [type, n] : s.skipped_by_type) {
-    j += (first ? "\"" : ",\"") + traverse::json_escape(type) + "\":" + std::to_string(n);
-    first = false;
-  }
-  j += "},\"malformed_count\":" + std::to_string(s.malformed_count) + ",\"malformed_lines\":[";
-  for (std::size_t i = 0; i < s.malformed_lines.size(); ++i) {
-    if (i) j += ',';
-    j += std::to_string(s.malformed_lines[i]);
-  }
-  j += "],\"malformed_lines_capped\":" +
-       std::string(s.malformed_count > static_cast<int64_t>(s.malformed_lines.size()) ? "true"
-                                                                                      : "false");
-  j += ",\"backwards_timestamps\":" + std::to_string(s.backwards_count) + ",\"backwards_lines\":[";
-  for (std::size_t i = 0; i < s.backwards_lines.size(); ++i) {
-    if (i) j += ',';
-    j += std::to_string(s.backwards_lines[i]);
-  }
-  j += "],\"max_backstep_us\":" + std::to_string(s.max_backstep_us);
-  char quantum[160];
-  std::snprintf(quantum, sizeof(quantum),
-                ",\"timestamp_quantum_s\":%.6g,\"quantised_timestamps\":%lld,"
-                "\"restamped_from_logger\":%lld,\"restamped_nominal\":%lld,"
-                "\"nominal_scan_period_s\":%.6g",
-                s.max_quantum_s, static_cast<long long>(s.quantised_count),
-                static_cast<long long>(s.restamped_logger),
-                static_cast<long long>(s.restamped_nominal), nominal_period_s);
-  j += quantum;
-  j += ",\"first_utime\":" + std::to_string(run.first_utime) +
-       ",\"last_utime\":" + std::to_string(run.last_utime);
-  char wall[64];
-  std::snprintf(wall, sizeof(wall), "%.3f", run.wall_s);
-  j += ",\"wall_s\":" + std::string(wall) +
-       ",\"interrupted\":" + (run.interrupted ? "true" : "false") + ",\"input_error\":\"" +
-       traverse::json_escape(s.input_error) + "\",\"out\":\"" + traverse::json_escape(out_path) +
-       "\"}";
-  std::printf("%s\n", j.c_str());
-  std::fflush(stdout);
 }
 
 // Sleeps until wall time `target_utime` [us], publishing status meanwhile; false if stopped.
@@ -127,6 +40,15 @@ bool wait_until(traverse::Process& proc, int64_t target_utime) {
     proc.maybe_publish_status();
   }
   return false;
+}
+
+void set_survey_counters(traverse::Process& proc, const carmen::Summary& s) {
+  proc.counter("timestamps_without_time") = s.time.clock == carmen::Clock::kIpc ? 0.0 : 1.0;
+  proc.counter("scans_restamped_logger") = static_cast<double>(s.restamped_logger);
+  proc.counter("scans_restamped_nominal") = static_cast<double>(s.restamped_nominal);
+  proc.counter("no_return_code_m") = s.no_return ? s.no_return->code_m : 0.0;
+  proc.counter("odometry_reanchors") = static_cast<double>(s.odometry_reanchors);
+  proc.counter("odometry_out_of_order") = static_cast<double>(s.odometry_out_of_order);
 }
 
 }  // namespace
@@ -143,34 +65,34 @@ int main(int argc, char** argv) {
       .add_option("--speed", speed, "live pace: log time x SPEED (0 = as fast as possible)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  traverse::carmen::CarmenConfig cfg;
+  carmen::CarmenConfig cfg;
   const bool to_file = writes_log_file(argc, argv);
   if (auto rc = proc.start(argc, argv, cfg, !to_file)) return *rc;
-  const auto geometry = traverse::carmen::parse_flaser_geometry(cfg.flaser_geometry);
-  if (!geometry) {
-    spdlog::error(
-        "traverse-carmen: config error: {}: flaser_geometry: '{}' is not one of "
-        "standard, half_open, closed, centered, reversed",
-        proc.config_path().empty() ? "(defaults)" : proc.config_path(), cfg.flaser_geometry);
+  if (const auto problem = carmen::validate(cfg)) {
+    spdlog::error("traverse-carmen: config error: {}: {}",
+                  proc.config_path().empty() ? "(defaults)" : proc.config_path(), *problem);
     return traverse::kConfigErrorExitCode;
   }
   if (log_path.empty()) {
     spdlog::error("traverse-carmen: no CARMEN log given (see --help)");
     return traverse::kConfigErrorExitCode;
   }
-  if (!(cfg.max_timestamp_quantum_s > 0.0 && cfg.nominal_scan_period_s > 0.0)) {
-    spdlog::error(
-        "traverse-carmen: config error: {}: max_timestamp_quantum_s and nominal_scan_period_s "
-        "must be positive",
-        proc.config_path().empty() ? "(defaults)" : proc.config_path());
-    return traverse::kConfigErrorExitCode;
-  }
-  traverse::carmen::Reader reader(log_path, *geometry,
-                                  {cfg.max_timestamp_quantum_s, cfg.nominal_scan_period_s});
+  carmen::Reader reader(log_path, *carmen::parse_flaser_geometry(cfg.flaser_geometry),
+                        {cfg.max_timestamp_quantum_s, cfg.nominal_scan_period_s},
+                        {cfg.no_return_code_m, cfg.no_return_min_fraction});
   if (!reader.good()) {
     spdlog::error("traverse-carmen: cannot read '{}'", log_path);
     return 1;
   }
+  const carmen::Summary survey = reader.summary();
+  carmen::RunFacts run;
+  run.out_path = out_path;
+  run.odometry_source = carmen::choose_odometry_source(cfg.odometry_source, survey);
+  std::istringstream warnings(carmen::survey_warnings(survey, cfg, run.odometry_source));
+  for (std::string line; std::getline(warnings, line);) {
+    spdlog::warn("traverse-carmen: {}: {}", log_path, line);
+  }
+  set_survey_counters(proc, survey);
 
   std::unique_ptr<traverse::LogFilePublisher> file;
   if (to_file) {
@@ -182,35 +104,47 @@ int main(int argc, char** argv) {
     }
   }
   traverse::Publisher& out = to_file ? static_cast<traverse::Publisher&>(*file) : proc.bus();
-
-  RunFacts run;
+  // Live, each message waits for its time: the log's pace times --speed, from the first message.
   const int64_t wall_start = traverse::now_utime();
+  std::optional<int64_t> first_utime;
+  bool stopped = false;
+  auto pace = [&](int64_t utime) {
+    if (!first_utime) first_utime = utime;
+    if (to_file || speed <= 0.0 || stopped) return;
+    stopped = !wait_until(proc, wall_start + static_cast<int64_t>((utime - *first_utime) / speed));
+  };
+  carmen::Driver driver(out, cfg, run.odometry_source, survey, pace);
   if (!to_file) proc.publish_status("running");
-  while (auto scan = reader.next()) {
-    if (run.scans_published == 0) run.first_utime = scan->utime;
-    if (!to_file && speed > 0.0 &&
-        !wait_until(proc,
-                    wall_start + static_cast<int64_t>((scan->utime - run.first_utime) / speed))) {
-      break;
+  while (auto record = reader.next_record()) {
+    driver.publish(*record);
+    if (const auto* scan = std::get_if<carmen::Scan>(&*record)) {
+      if (driver.scans() == 1) run.first_utime = scan->utime;
+      run.last_utime = scan->utime;
     }
-    traverse::carmen::publish_scan(out, *scan, cfg);
-    run.last_utime = scan->utime;
-    ++run.scans_published;
-    ++run.poses_published;
-    proc.counter("scans_published") = static_cast<double>(run.scans_published);
-    proc.counter("malformed_lines") = static_cast<double>(reader.summary().malformed_count);
+    proc.counter("scans_published") = static_cast<double>(driver.scans());
+    proc.counter("odometry_published") = static_cast<double>(driver.odometry());
+    proc.counter("odometry_behind_scans") = static_cast<double>(driver.odometry_behind_scans());
+    proc.counter("scans_thinned") = static_cast<double>(driver.scans_thinned());
     if (!to_file) proc.maybe_publish_status();
     if (traverse::stop_requested()) break;
   }
+  if (!traverse::stop_requested()) driver.finish();
+  run.scans_published = run.poses_published = driver.scans();
+  run.odometry_published = driver.odometry();
+  run.scans_thinned = driver.scans_thinned();
+  run.odometry_behind_scans = driver.odometry_behind_scans();
   run.interrupted = traverse::stop_requested();
-  run.wall_s = 1e-6 * (traverse::now_utime() - wall_start);
+  run.wall_s = 1e-6 * static_cast<double>(traverse::now_utime() - wall_start);
+  const carmen::Summary& summary = reader.summary();
+  proc.counter("malformed_lines") = static_cast<double>(summary.malformed_count);
   if (!to_file) {
     proc.publish_status(run.interrupted ? "stopping: interrupted" : "stopping: end of log");
   }
   file.reset();  // close the log before reporting
-  const bool damaged = !reader.summary().input_error.empty();
-  if (damaged) spdlog::error("traverse-carmen: {}", reader.summary().input_error);
-  print_summary(reader.summary(), run, out_path,
-                cfg.nominal_scan_period_s);  // JSON last, also when stderr is merged
+  const bool damaged = !summary.input_error.empty();
+  if (damaged) spdlog::error("traverse-carmen: {}", summary.input_error);
+  std::fputs(carmen::summary_text(summary, run).c_str(), stdout);
+  std::printf("%s\n", carmen::summary_json(summary, run, cfg).c_str());  // JSON last
+  std::fflush(stdout);
   return damaged ? 1 : 0;
 }

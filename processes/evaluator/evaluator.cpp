@@ -1,20 +1,23 @@
 #include "evaluator.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include "config.hpp"
 
 namespace traverse::evaluator {
 
 std::optional<std::string> validate(const EvaluatorConfig& config) {
-  if (!parse_align(config.align)) {
-    return "align: '" + config.align + "' is not one of none, first_pose, se2";
-  }
-  if (config.match.max_reference_gap_us <= 0) return "max_reference_gap_us: must be positive";
-  if (config.match.edge_tolerance_us < 0) return "edge_tolerance_us: must not be negative";
-  if (!(config.false_closure_sigmas > 0.0) || !std::isfinite(config.false_closure_sigmas)) {
-    return "false_closure_sigmas: must be a positive number of standard deviations";
-  }
-  if (config.key_poses_channel.empty()) return "key_poses_channel: must not be empty";
-  return std::nullopt;
+  ConfigCheck check;
+  check.require(parse_align(config.align).has_value(), "align",
+                "must be one of none, first_pose, se2, got '" + config.align + "'");
+  check.positive("max_reference_gap_us", config.match.max_reference_gap_us);
+  check.not_negative("edge_tolerance_us", config.match.edge_tolerance_us);
+  check.positive("false_closure_sigmas", config.false_closure_sigmas);
+  check.not_empty("key_poses_channel", config.key_poses_channel);
+  check.in_range("min_reference_share", config.min_reference_share, 0.0, 1.0);
+  check.not_negative("relation_time_tolerance_us", config.relation_time_tolerance_us);
+  return check.problem();
 }
 
 void shift(Trajectory& trajectory, double dx_m, double dy_m, double dtheta_rad) {
@@ -49,6 +52,16 @@ Evaluation evaluate(Trajectory estimate, Trajectory reference, const EvaluatorCo
     utimes.push_back(e.utime);
   }
   ev.matched = est.size();
+  if (!utimes.empty()) {
+    ev.reference_covered = static_cast<std::size_t>(
+        std::count_if(reference.begin(), reference.end(), [&](const StampedPose& r) {
+          return r.utime >= utimes.front() && r.utime <= utimes.back();
+        }));
+  }
+  ev.reference_share = reference.empty() ? 0.0
+                                         : static_cast<double>(ev.reference_covered) /
+                                               static_cast<double>(reference.size());
+  ev.refused = ev.reference_share < config.min_reference_share;
 
   // 2. Align the estimate's frame to the reference frame.
   ev.alignment = compute_alignment(*parse_align(config.align), est, ref);

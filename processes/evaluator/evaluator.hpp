@@ -14,6 +14,7 @@
 #include "final_trajectory.hpp"
 #include "loop_closures.hpp"
 #include "metrics.hpp"
+#include "relations.hpp"
 #include "trajectory.hpp"
 
 namespace traverse::evaluator {
@@ -26,6 +27,13 @@ struct EvaluatorConfig {
   double false_closure_sigmas = 5.0;
   // key_poses_t channel whose loop closures are checked (the backend's; absent without one).
   std::string key_poses_channel = "KEY_POSES";
+  // [0..1] No figures (exit non-zero) when the estimate covers less than this share of the
+  // reference: of its poses (those inside the span of the matched estimate), or of the relations
+  // (--relations). A stage that stopped early or published a single pose is a failure, not a
+  // perfect run.
+  double min_reference_share = 0.8;
+  // [us] --relations: a pose this close to a relation's scan stamp is that scan's (relations.hpp).
+  int64_t relation_time_tolerance_us = 0;
 
   template <class V>
   void visit(V& v) {
@@ -34,6 +42,8 @@ struct EvaluatorConfig {
     v("edge_tolerance_us", match.edge_tolerance_us);
     v("false_closure_sigmas", false_closure_sigmas);
     v("key_poses_channel", key_poses_channel);
+    v("min_reference_share", min_reference_share);
+    v("relation_time_tolerance_us", relation_time_tolerance_us);
   }
 };
 
@@ -59,6 +69,11 @@ struct Evaluation {
   std::size_t reference_poses = 0;
   std::size_t matched = 0;
   std::size_t unmatched = 0;  // outside the reference span or inside a reference gap
+  // Reference poses from the first to the last matched estimate's time, and their share of all:
+  // how much of the reference the estimate covers.
+  std::size_t reference_covered = 0;
+  double reference_share = 0.0;
+  bool refused = false;  // reference_share below the config's min_reference_share
   Alignment alignment;
   ErrorStats position_m;   // [m]
   ErrorStats heading_rad;  // [rad] of |heading error|

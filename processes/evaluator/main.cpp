@@ -32,6 +32,7 @@ struct Options {
   std::string out;
   std::string align;
   std::vector<double> shift;  // dx [m], dy [m], dtheta [rad]
+  std::string relations;      // a .relations file: score by relations instead (relations.hpp)
 };
 
 // Offline runs must not need a network: look for --log before the process connects to LCM.
@@ -51,7 +52,13 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--reference", opt.reference,
                  "pose2d_t channel of the reference (ground truth or reference poses)")
       ->capture_default_str();
-  app.add_option("--out", opt.out, "directory for errors.csv and errors.png");
+  app.add_option("--out", opt.out,
+                 "directory for errors.csv, errors.png and closures.csv (relations.csv with "
+                 "--relations)");
+  app.add_option("--relations", opt.relations,
+                 "score the estimate by the relations in FILE (Kuemmerle et al. 2009: t1 t2 dx dy "
+                 "dz droll dpitch dyaw per line) instead of against --reference")
+      ->check(CLI::ExistingFile);
   app.add_option("--align", opt.align, "override the config's align: none, first_pose or se2")
       ->check(CLI::IsMember({"none", "first_pose", "se2"}));
   app.add_option("--shift-estimate", opt.shift,
@@ -100,6 +107,56 @@ bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
   return true;
 }
 
+// The JSON fields every mode reports about the estimate channel and the log it was read from.
+void add_input_facts(const Options& opt, const ev::PoseCollector& collector, bool offline,
+                     const ev::PoseCollector::LogSummary& log_summary, ev::JsonLine& json) {
+  const std::string type = ev::estimate_type_name(collector.estimate_type());
+  json.add("estimate_channel", opt.estimate);
+  if (type.empty()) {
+    json.add_null("estimate_type");
+  } else {
+    json.add("estimate_type", type);
+  }
+  json.add_int("non_finite_poses", static_cast<long long>(collector.non_finite_poses()))
+      .add_int("decode_failures", static_cast<long long>(collector.decode_failures()))
+      .add_int("mixed_type_messages", static_cast<long long>(collector.mixed_type_messages()));
+  if (offline) {
+    json.add("log", opt.log)
+        .add_int("log_damaged_records", static_cast<long long>(log_summary.damaged_records));
+  }
+}
+
+// --relations: the estimate scored by the relations; exit 1 when the figures are refused.
+int score_relations(const Options& opt, const ev::EvaluatorConfig& cfg,
+                    const ev::RelationsFile& file, const ev::Trajectory& estimate,
+                    ev::JsonLine& json) {
+  const ev::RelationsEvaluation r = ev::evaluate_relations(
+      estimate, file.relations, {cfg.relation_time_tolerance_us, cfg.min_reference_share});
+  json.add("mode", "relations").add("relations_file", opt.relations);
+  ev::add_relations(r, json);
+  json.add("min_reference_share", cfg.min_reference_share, 3)
+      .add_int("relation_time_tolerance_us", static_cast<long long>(cfg.relation_time_tolerance_us))
+      .add_int("relations_malformed_lines", static_cast<long long>(file.malformed_count))
+      .add_int("estimate_poses", static_cast<long long>(estimate.size()));
+  if (r.refused) {
+    spdlog::error(
+        "traverse-evaluator: {} of {} relations ({:.1f} %) have a pose on {} at both scans' "
+        "stamps, below min_reference_share {:.0f} %: no figures",
+        r.used, r.relations, 100.0 * r.share, opt.estimate, 100.0 * cfg.min_reference_share);
+  }
+  if (!opt.out.empty()) {
+    std::error_code ec;
+    fs::create_directories(opt.out, ec);
+    const std::string csv = (fs::path(opt.out) / "relations.csv").string();
+    if (!ev::write_relations_csv(r, csv)) {
+      spdlog::error("traverse-evaluator: cannot write {}", csv);
+      return 1;
+    }
+    json.add("relations_csv", csv);
+  }
+  return r.refused ? 1 : 0;
+}
+
 // A channel carrying several types is an error of the graph, not of the figures: say so loudly.
 void report_type_problems(const ev::PoseCollector& collector, const std::string& estimate_channel) {
   if (collector.mixed_type_messages() == 0) return;
@@ -135,6 +192,19 @@ int main(int argc, char** argv) {
     return traverse::kConfigErrorExitCode;
   }
 
+  ev::RelationsFile relations;
+  if (!opt.relations.empty()) {
+    relations = ev::read_relations(opt.relations);
+    if (!relations.error.empty()) {
+      spdlog::error("traverse-evaluator: {}", relations.error);
+      return 1;
+    }
+    if (relations.malformed_count > 0) {
+      spdlog::warn("traverse-evaluator: {}: {} malformed line(s) skipped, the first line {}",
+                   opt.relations, relations.malformed_count, relations.malformed_lines.front());
+    }
+  }
+
   ev::PoseCollector collector(opt.estimate, opt.reference, cfg.key_poses_channel);
   ev::PoseCollector::LogSummary log_summary;
   if (offline) {
@@ -158,37 +228,39 @@ int main(int argc, char** argv) {
 
   ev::Trajectory estimate = collector.estimate();
   if (opt.shift.size() == 3) ev::shift(estimate, opt.shift[0], opt.shift[1], opt.shift[2]);
+  report_type_problems(collector, opt.estimate);
+  ev::JsonLine json;
+  if (!opt.relations.empty()) {
+    const int rc = score_relations(opt, cfg, relations, estimate, json);
+    add_input_facts(opt, collector, offline, log_summary, json);
+    std::cout << json.str() << std::endl;
+    return rc;
+  }
+
   const ev::Evaluation evaluation = ev::evaluate(estimate, collector.reference(), cfg);
   const ev::ClosureEvaluation closures = ev::check_closures(
       collector.closures().closures(), collector.reference(), cfg.match, cfg.false_closure_sigmas);
-  report_type_problems(collector, opt.estimate);
-
-  ev::JsonLine json;
   ev::add_evaluation(evaluation, json);
+  json.add("min_reference_share", cfg.min_reference_share, 3);
   ev::add_closures(closures, json);
-  const std::string type = ev::estimate_type_name(collector.estimate_type());
-  json.add("estimate_channel", opt.estimate);
-  if (type.empty()) {
-    json.add_null("estimate_type");
-  } else {
-    json.add("estimate_type", type);
-  }
+  add_input_facts(opt, collector, offline, log_summary, json);
   json.add("reference_channel", opt.reference)
       .add("key_poses_channel", cfg.key_poses_channel)
       .add_int("key_pose_revisions", static_cast<long long>(collector.key_poses().replaced()))
-      .add_int("dense_segments", static_cast<long long>(collector.dense().size()))
-      .add_int("non_finite_poses", static_cast<long long>(collector.non_finite_poses()))
-      .add_int("decode_failures", static_cast<long long>(collector.decode_failures()))
-      .add_int("mixed_type_messages", static_cast<long long>(collector.mixed_type_messages()));
-  if (offline) {
-    json.add("log", opt.log)
-        .add_int("log_damaged_records", static_cast<long long>(log_summary.damaged_records));
-  }
-  int rc = evaluation.matched > 0 ? 0 : 1;
+      .add_int("dense_segments", static_cast<long long>(collector.dense().size()));
+  int rc = 0;
   if (evaluation.matched == 0) {
     spdlog::error(
         "traverse-evaluator: no estimate pose on {} matched a pose on {} ({} and {} poses)",
         opt.estimate, opt.reference, evaluation.estimate_poses, evaluation.reference_poses);
+    rc = 1;
+  } else if (evaluation.refused) {
+    spdlog::error(
+        "traverse-evaluator: the {} matched poses of {} cover {} of the {} poses on {} ({:.1f} "
+        "%), below min_reference_share {:.0f} %: no figures",
+        evaluation.matched, opt.estimate, evaluation.reference_covered, evaluation.reference_poses,
+        opt.reference, 100.0 * evaluation.reference_share, 100.0 * cfg.min_reference_share);
+    rc = 1;
   }
   if (!opt.out.empty() && !write_outputs(opt, evaluation, closures, json)) return 1;
   std::cout << json.str() << std::endl;

@@ -113,6 +113,11 @@ JsonLine& JsonLine::add_int(const std::string& key, long long value) {
   return *this;
 }
 
+JsonLine& JsonLine::add_bool(const std::string& key, bool value) {
+  fields_.emplace_back(key, value ? "true" : "false");
+  return *this;
+}
+
 JsonLine& JsonLine::add_null(const std::string& key) {
   fields_.emplace_back(key, "null");
   return *this;
@@ -128,23 +133,26 @@ std::string JsonLine::str() const {
 }
 
 void add_evaluation(const Evaluation& ev, JsonLine& json) {
-  // With nothing matched there are no errors to report, not zero errors.
+  // With nothing matched there are no errors to report, not zero errors; with too little of the
+  // reference covered, none that mean anything.
+  const bool report = ev.matched > 0 && !ev.refused;
   const auto figure = [&](double value) {
-    return ev.matched > 0 ? std::optional<double>(value) : std::nullopt;
+    return report ? std::optional<double>(value) : std::nullopt;
   };
+  const auto optional = [&](std::optional<double> value) { return report ? value : std::nullopt; };
   json.add("position_rmse_m", figure(ev.position_m.rmse))
       .add("position_sd_m", figure(ev.position_m.sd))
       .add("position_max_m", figure(ev.position_m.max))
       .add("heading_rmse_deg", figure(kDegPerRad * ev.heading_rad.rmse))
       .add("heading_sd_deg", figure(kDegPerRad * ev.heading_rad.sd))
       .add("heading_max_deg", figure(kDegPerRad * ev.heading_rad.max))
-      .add("rpe_1m_m", ev.rpe_1m.rms_m)
-      .add("rpe_10m_m", ev.rpe_10m.rms_m)
+      .add("rpe_1m_m", optional(ev.rpe_1m.rms_m))
+      .add("rpe_10m_m", optional(ev.rpe_10m.rms_m))
       .add_int("rpe_1m_pairs", static_cast<long long>(ev.rpe_1m.pairs))
       .add_int("rpe_10m_pairs", static_cast<long long>(ev.rpe_10m.pairs))
       .add("max_jump_m", figure(ev.max_jump.step_error_m))
-      .add("step_nees_median", ev.step_consistency.nees_median)
-      .add("step_outside_99_fraction", ev.step_consistency.outside_99_fraction)
+      .add("step_nees_median", optional(ev.step_consistency.nees_median))
+      .add("step_outside_99_fraction", optional(ev.step_consistency.outside_99_fraction))
       .add_int("step_nees_steps", static_cast<long long>(ev.step_consistency.steps));
   if (ev.samples.size() >= 2) {
     const int64_t t0 = ev.samples.front().utime;
@@ -157,6 +165,9 @@ void add_evaluation(const Evaluation& ev, JsonLine& json) {
       .add_int("unmatched", static_cast<long long>(ev.unmatched))
       .add_int("estimate_poses", static_cast<long long>(ev.estimate_poses))
       .add_int("reference_poses", static_cast<long long>(ev.reference_poses))
+      .add_int("reference_covered", static_cast<long long>(ev.reference_covered))
+      .add("reference_share", ev.reference_share, 4)
+      .add_bool("refused", ev.refused)
       .add("duration_s", ev.duration_s, 3)
       .add("length_m", ev.length_m, 3)
       .add("align", align_name(ev.alignment.used))
@@ -173,6 +184,46 @@ void add_closures(const ClosureEvaluation& ev, JsonLine& json) {
       .add("loop_closure_max_mahalanobis", ev.max_mahalanobis, 3)
       .add("loop_closure_max_error_m", ev.max_error_m)
       .add("loop_closure_rms_error_m", ev.rms_error_m);
+}
+
+void add_relations(const RelationsEvaluation& ev, JsonLine& json) {
+  const bool report = !ev.refused && ev.used > 0;
+  const auto figure = [&](double value) {
+    return report ? std::optional<double>(value) : std::nullopt;
+  };
+  json.add_int("relations", static_cast<long long>(ev.relations))
+      .add_int("relations_used", static_cast<long long>(ev.used))
+      .add_int("relations_missing", static_cast<long long>(ev.missing))
+      .add("relations_share", ev.share, 4)
+      .add_bool("refused", ev.refused)
+      .add("trans_mean_m", figure(ev.translation_m.mean))
+      .add("trans_sd_m", figure(ev.translation_m.sd))
+      .add("trans_max_m", figure(ev.translation_m.max))
+      .add("trans_sq_mean_m2", figure(ev.translation_sq_m2.mean), 8)
+      .add("trans_sq_sd_m2", figure(ev.translation_sq_m2.sd), 8)
+      .add("rot_mean_deg", figure(ev.rotation_deg.mean))
+      .add("rot_sd_deg", figure(ev.rotation_deg.sd))
+      .add("rot_max_deg", figure(ev.rotation_deg.max))
+      .add("rot_sq_mean_deg2", figure(ev.rotation_sq_deg2.mean))
+      .add("rot_sq_sd_deg2", figure(ev.rotation_sq_deg2.sd));
+}
+
+bool write_relations_csv(const RelationsEvaluation& ev, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) return false;
+  out << "line,t1_us,t2_us,used,has_t1,has_t2,rel_x_m,rel_y_m,rel_theta_deg,est_x_m,est_y_m,"
+         "est_theta_deg,trans_error_m,rot_error_deg\n";
+  for (const RelationCheck& c : ev.checks) {
+    const Relation& r = c.relation;
+    const bool u = c.used();
+    const auto num = [u](double v) { return u ? fmt::format("{:.6f}", v) : std::string(); };
+    out << fmt::format("{},{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{},{},{},{}\n", r.line,
+                       r.t1_utime, r.t2_utime, u ? 1 : 0, c.has_t1 ? 1 : 0, c.has_t2 ? 1 : 0,
+                       r.T_1_2.x(), r.T_1_2.y(), kDegPerRad * r.T_1_2.theta(), num(c.T_est_1_2.x()),
+                       num(c.T_est_1_2.y()), num(kDegPerRad * c.T_est_1_2.theta()),
+                       num(c.translation_error_m), num(kDegPerRad * c.rotation_error_rad));
+  }
+  return static_cast<bool>(out.flush());
 }
 
 }  // namespace traverse::evaluator

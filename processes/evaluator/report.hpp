@@ -30,6 +30,7 @@ class JsonLine {
   JsonLine& add(const std::string& key, double value, int decimals = 6);  // null if not finite
   JsonLine& add(const std::string& key, std::optional<double> value, int decimals = 6);
   JsonLine& add_int(const std::string& key, long long value);
+  JsonLine& add_bool(const std::string& key, bool value);
   JsonLine& add_null(const std::string& key);
   std::string str() const;
 
@@ -42,5 +43,13 @@ void add_evaluation(const Evaluation& ev, JsonLine& json);
 
 // The loop-closure figures: always present, counts 0 and figures null when there is no closure.
 void add_closures(const ClosureEvaluation& ev, JsonLine& json);
+
+// The relations figures (relations.hpp): counts always, figures null when refused. Keys:
+// relations, relations_used, relations_missing, relations_share, refused, trans_{mean,sd,max}_m,
+// trans_sq_{mean,sd}_m2, rot_{mean,sd,max}_deg, rot_sq_{mean,sd}_deg2.
+void add_relations(const RelationsEvaluation& ev, JsonLine& json);
+
+// One row per relation: stamps, used, the relation and the estimate's relative pose, errors.
+bool write_relations_csv(const RelationsEvaluation& ev, const std::string& path);
 
 }  // namespace traverse::evaluator

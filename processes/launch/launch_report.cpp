@@ -31,7 +31,9 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
     r.outcome = c.outcome();
     r.exit_code = c.exit_code;
     r.signal = c.term_signal;
-    const bool infrastructure = c.name == "logger" || c.name == "monitor";
+    // Live, the logger and the monitor run until stopped; offline the monitor ends on its own.
+    const bool infrastructure =
+        c.name == "logger" || (c.name == "monitor" && report.url != "offline");
     if (c.died()) {
       r.failed = true;
       r.why = c.asked_to_stop ? "failed while stopping" : "died";
@@ -46,9 +48,10 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
     report.children.push_back(std::move(r));
   }
   if (!all_started) report.failed.push_back("(launcher: a process could not be started)");
-  report.ok = report.failed.empty() && !report.interrupted;
+  report.ok = report.failed.empty() && report.verdict_problems.empty() && !report.interrupted;
   if (!report.failed.empty()) return 1;
-  return report.interrupted ? 130 : 0;
+  if (report.interrupted) return 130;
+  return report.verdict_problems.empty() ? 0 : kVerdictFailedExitCode;
 }
 
 std::string to_text(const RunReport& report) {
@@ -62,6 +65,7 @@ std::string to_text(const RunReport& report) {
     s += line;
   }
   for (const auto& n : report.not_ready) s += "  no status before replay from: " + n + "\n";
+  for (const auto& p : report.verdict_problems) s += "  VERDICT: " + p + "\n";
   s += report.failed.empty()
            ? (report.interrupted ? "  interrupted; every process stopped cleanly\n"
                                  : "  all processes ran to the end\n")
@@ -88,6 +92,11 @@ std::string to_json(const RunReport& report) {
   for (std::size_t i = 0; i < report.failed.size(); ++i) {
     if (i) j += ',';
     j += quoted(report.failed[i]);
+  }
+  j += "],\"problems\":[";
+  for (std::size_t k = 0; k < report.verdict_problems.size(); ++k) {
+    if (k) j += ',';
+    j += quoted(report.verdict_problems[k]);
   }
   j += "],\"not_ready\":[";
   std::size_t i = 0;

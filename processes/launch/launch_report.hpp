@@ -28,11 +28,15 @@ struct RunReport {
   std::set<std::string> not_ready;  // processes with no status before playback
   std::vector<ChildReport> children;
   std::vector<std::string> failed;
+  std::vector<std::string> verdict_problems;  // input log, monitor's verdict (run_checks.hpp)
   bool ok = false;
 };
 
+// Exit code when every process ran to the end but the run's verdict fails.
+inline constexpr int kVerdictFailedExitCode = 3;
+
 // Fills `report` from the ended children; returns the launcher's exit code (0 ok, 1 a failure,
-// 130 interrupted without failure).
+// 3 the verdict failed, 130 interrupted without failure).
 int finish_report(RunReport& report, const Supervisor& sup, bool all_started);
 
 std::string to_text(const RunReport& report);

@@ -3,8 +3,10 @@
 // and the deployment's processes, waits until each has published its first status, replays the
 // input log with lcm-logplayer, and when playback ends (or on SIGINT/SIGTERM) stops the processes,
 // then the monitor, then the logger. The summary (also OUTDIR/run-graph.json) ends with one JSON
-// line. Exit 0 when every process lasted to the end and stopped cleanly, 1 when one died or had
-// to be killed, 2 for bad arguments, 130 when interrupted.
+// line. Exit 0 when every process lasted to the end and stopped cleanly and the run's verdict is
+// ok (input log readable and undamaged, the monitor's thresholds kept: run_checks.hpp), 1 when a
+// process died or had to be killed, 2 for bad arguments, 3 when the verdict fails, 130 when
+// interrupted. Offline, the monitor judges the recorded run afterwards (--replay).
 #include <signal.h>
 #include <unistd.h>
 
@@ -23,6 +25,7 @@
 #include "config.hpp"
 #include "deployment.hpp"
 #include "launch_report.hpp"
+#include "run_checks.hpp"
 #include "supervisor.hpp"
 
 namespace fs = std::filesystem;
@@ -36,7 +39,7 @@ void on_signal(int) { g_interrupted = true; }
 struct Options {
   std::string deploy, log, out, stages = "all", lcm_url, root = ".", bin_dir;
   double speed = 1.0, grace_s = 2.0, stop_timeout_s = 5.0, ready_timeout_s = 10.0;
-  bool offline = false;
+  bool offline = false, raise_rmem_max = false;
 };
 
 void add_options(CLI::App& app, Options& o) {
@@ -65,27 +68,8 @@ void add_options(CLI::App& app, Options& o) {
   app.add_flag("--offline", o.offline,
                "no bus: run the stages one after another on the log (--replay/--record), as "
                "fast as they compute and without transport loss; --speed is ignored");
-}
-
-// Raises net.core.rmem_max to the URL's receive buffer when running as root; says what it did.
-void raise_rmem_max(long wanted) {
-  if (wanted <= 0) return;
-  const char* path = "/proc/sys/net/core/rmem_max";
-  long current = 0;
-  std::ifstream(path) >> current;
-  if (current >= wanted) return;
-  if (geteuid() != 0) {
-    std::fprintf(stderr,
-                 "run-graph: net.core.rmem_max is %ld bytes (< %ld): not root, LCM may "
-                 "drop bursts\n",
-                 current, wanted);
-    return;
-  }
-  std::ofstream out(path);
-  out << wanted;
-  out.close();
-  std::fprintf(stderr, "run-graph: net.core.rmem_max %ld -> %ld bytes%s\n", current, wanted,
-               out ? "" : " FAILED (read-only /proc/sys?)");
+  app.add_flag("--raise-rmem-max", o.raise_rmem_max,
+               "as root, raise net.core.rmem_max (system-wide) to the URL's recv_buf_size");
 }
 
 std::string find_program(const std::string& program, const std::string& bin_dir) {
@@ -156,7 +140,8 @@ struct Planned {
 // --replay and writes its own with --record: everything the input had plus what the stage
 // published. The last record becomes run.lcmlog; the ones in between are deleted as soon as the
 // next stage has read them. Deterministic: the same input gives the same messages.
-int run_offline(const Options& o, const std::vector<Planned>& planned, const fs::path& out_dir) {
+int run_offline(const Options& o, const std::vector<Planned>& planned, const fs::path& out_dir,
+                std::vector<std::string> monitor_argv) {
   const auto t0 = std::chrono::steady_clock::now();
   Supervisor sup;
   std::string error;
@@ -196,6 +181,23 @@ int run_offline(const Options& o, const std::vector<Planned>& planned, const fs:
   traverse::launch::RunReport report;
   report.url = "offline";
   report.out_dir = out_dir.string();
+  report.verdict_problems = traverse::launch::input_log_problems(o.log);
+  if (ok && !g_interrupted && !ec) {
+    // The monitor judges the recorded run: what each stage reported in its statuses.
+    std::vector<std::string> argv = monitor_argv;
+    argv.insert(argv.end(), {"--replay", (out_dir / "run.lcmlog").string()});
+    std::fprintf(stderr, "run-graph: the monitor judges %s\n", (out_dir / "run.lcmlog").c_str());
+    if (sup.spawn("monitor", argv, (out_dir / "monitor.log").string(), error)) {
+      while (sup.find("monitor")->running && !g_interrupted) {
+        sup.reap();
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      sup.stop({"monitor"}, o.stop_timeout_s);
+    }
+    for (auto& p : traverse::launch::monitor_problems((out_dir / "monitor.json").string())) {
+      report.verdict_problems.push_back(std::move(p));
+    }
+  }
   report.interrupted = g_interrupted;
   report.duration_s = report.replay_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -293,7 +295,13 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
-  if (o.offline) return run_offline(o, planned, fs::absolute(o.out));
+  const fs::path monitor_config = fs::path(o.root) / "configs" / "monitor.yaml";
+  std::vector<std::string> monitor_argv = {monitor, "--name", "monitor", "--out",
+                                           (fs::absolute(o.out) / "monitor.json").string()};
+  if (fs::is_regular_file(monitor_config)) {
+    monitor_argv.insert(monitor_argv.end(), {"--config", fs::absolute(monitor_config).string()});
+  }
+  if (o.offline) return run_offline(o, planned, fs::absolute(o.out), monitor_argv);
   std::optional<traverse::launch::PortLease> lease;
   if (o.lcm_url.empty()) {
     lease = traverse::launch::reserve_port(fs::temp_directory_path() / "traverse-lcm-ports", 20000,
@@ -304,23 +312,15 @@ int main(int argc, char** argv) {
     }
     o.lcm_url = traverse::launch::private_url(lease->port(), 8 << 20);
   }
-  raise_rmem_max(traverse::launch::recv_buf_size_of(o.lcm_url));
+  const std::string rmem = traverse::launch::check_rmem_max(
+      traverse::launch::recv_buf_size_of(o.lcm_url), o.raise_rmem_max);
+  if (!rmem.empty()) std::fprintf(stderr, "run-graph: %s\n", rmem.c_str());
 
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path out_dir = fs::absolute(o.out);
   const std::string url_arg = "--lcm-url=" + o.lcm_url;
   Supervisor sup;
-  std::vector<std::string> monitor_argv = {monitor,
-                                           "--lcm-url",
-                                           o.lcm_url,
-                                           "--name",
-                                           "monitor",
-                                           "--out",
-                                           (out_dir / "monitor.json").string()};
-  const fs::path monitor_config = fs::path(o.root) / "configs" / "monitor.yaml";
-  if (fs::is_regular_file(monitor_config)) {
-    monitor_argv.insert(monitor_argv.end(), {"--config", fs::absolute(monitor_config).string()});
-  }
+  monitor_argv.insert(monitor_argv.begin() + 1, {"--lcm-url", o.lcm_url});
   // LCM_SELF_TEST is udpm's own start-up probe, not part of the run: not recorded.
   bool spawned = sup.spawn("logger",
                            {logger, "-f", "-q", "-v", "--channel=LCM_SELF_TEST", url_arg,
@@ -343,6 +343,7 @@ int main(int argc, char** argv) {
   traverse::launch::RunReport report;
   report.url = o.lcm_url;
   report.out_dir = out_dir.string();
+  report.verdict_problems = traverse::launch::input_log_problems(o.log);
   report.not_ready = wait_until_ready(o.lcm_url, waiting, sup, o.ready_timeout_s);
   // The logger is listening once it has written something (the statuses just heard).
   const auto logger_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
@@ -401,6 +402,11 @@ int main(int argc, char** argv) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // last messages reach the logger
   sup.stop({"logger"}, o.stop_timeout_s);
   report.duration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!g_interrupted) {
+    for (auto& p : traverse::launch::monitor_problems((out_dir / "monitor.json").string())) {
+      report.verdict_problems.push_back(std::move(p));
+    }
+  }
 
   const int rc = traverse::launch::finish_report(report, sup, spawned);
   const std::string json = traverse::launch::to_json(report);

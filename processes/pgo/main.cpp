@@ -25,18 +25,22 @@ double cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
+// One line per pose; `component` says which connected component it is in: a covariance is
+// relative to its component's fixed vertex, and none relates two components.
 bool write_marginals(const traverse::backend::PoseGraph& graph,
-                     const std::vector<Eigen::Matrix3d>& cov, const std::string& path) {
+                     const std::vector<Eigen::Matrix3d>& cov, const std::vector<int>& component,
+                     const std::string& path) {
   std::ofstream out(path);
   if (!out) return false;
-  out << "id,x_m,y_m,theta_rad,cov_xx_m2,cov_xy_m2,cov_xtheta_m_rad,cov_yy_m2,cov_ytheta_m_rad,"
-         "cov_thetatheta_rad2\n";
+  out << "id,component,x_m,y_m,theta_rad,cov_xx_m2,cov_xy_m2,cov_xtheta_m_rad,cov_yy_m2,"
+         "cov_ytheta_m_rad,cov_thetatheta_rad2\n";
   out << std::setprecision(17);
   for (std::size_t v = 0; v < graph.poses.size(); ++v) {
     const auto& p = graph.poses[v];
     const Eigen::Matrix3d& c = cov[v];
-    out << graph.ids[v] << ',' << p.x() << ',' << p.y() << ',' << p.theta() << ',' << c(0, 0) << ','
-        << c(0, 1) << ',' << c(0, 2) << ',' << c(1, 1) << ',' << c(1, 2) << ',' << c(2, 2) << '\n';
+    out << graph.ids[v] << ',' << component[v] << ',' << p.x() << ',' << p.y() << ',' << p.theta()
+        << ',' << c(0, 0) << ',' << c(0, 1) << ',' << c(0, 2) << ',' << c(1, 1) << ',' << c(1, 2)
+        << ',' << c(2, 2) << '\n';
   }
   return static_cast<bool>(out);
 }
@@ -76,6 +80,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   traverse::backend::PoseGraph& graph = *read.graph;
+  int components = 0;
+  const std::vector<int> component = traverse::backend::components(graph, &components);
+  if (components > 1) {
+    std::printf("graph: %d connected components, one vertex fixed in each\n", components);
+  }
 
   traverse::backend::SpaOptimizer optimizer(config);
   auto t0 = std::chrono::steady_clock::now();
@@ -96,14 +105,14 @@ int main(int argc, char** argv) {
     const auto cov = optimizer.marginals(graph);
     marginals_s = seconds_since(t0);
     if (!cov) {
-      std::cerr << "traverse-pgo: marginals failed: the information matrix is singular "
-                   "(is the graph connected?)\n";
+      std::cerr << "traverse-pgo: marginals failed: the information matrix is singular at the "
+                   "optimised poses\n";
       return 1;
     }
     marginals_recovered = cov->size();
     std::printf("marginals: %zu poses in %.3f s (factor non-zeros %ld)\n", cov->size(), marginals_s,
                 optimizer.system().nnz_l());
-    if (!marginals_path.empty() && !write_marginals(graph, *cov, marginals_path)) {
+    if (!marginals_path.empty() && !write_marginals(graph, *cov, component, marginals_path)) {
       std::cerr << "traverse-pgo: cannot write " << marginals_path << '\n';
       return 1;
     }
@@ -113,12 +122,14 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf(
-      "{\"file\": \"%s\", \"vertices\": %zu, \"edges\": %zu, \"initial_chi2\": %.12g, "
+      "{\"file\": \"%s\", \"vertices\": %zu, \"edges\": %zu, \"components\": %d, "
+      "\"initialised_from_edges\": %s, \"initial_chi2\": %.12g, "
       "\"final_chi2\": %.12g, \"iterations\": %d, \"accepted_steps\": %d, \"converged\": %s, "
       "\"termination\": \"%s\", \"rejected_non_finite\": %d, \"solve_s\": %.6f, \"solve_cpu_s\": "
       "%.6f, \"marginals\": %zu, "
       "\"marginals_s\": %.6f, \"symbolic_analyses\": %d, \"factor_nnz\": %ld}\n",
-      file.c_str(), graph.poses.size(), graph.edges.size(), result.initial_chi2, result.final_chi2,
+      file.c_str(), graph.poses.size(), graph.edges.size(), components,
+      read.initialised_from_edges ? "true" : "false", result.initial_chi2, result.final_chi2,
       result.iterations, result.accepted_steps, result.converged ? "true" : "false",
       result.termination.c_str(), result.rejected_non_finite, solve_s, solve_cpu_s,
       marginals_recovered, marginals_s, optimizer.system().analyses(), optimizer.system().nnz_l());

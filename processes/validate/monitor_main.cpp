@@ -1,7 +1,9 @@
 // traverse-monitor: listens to every channel of a running graph and, when stopped (SIGINT or
 // SIGTERM), prints and writes (--out FILE) a JSON summary: per channel the checks of
-// traverse-validate, per process its last status and whether it went silent. Exits 0 unless LCM
-// failed or the summary could not be written; the summary's "ok" tells whether the run was clean.
+// traverse-validate, per process its last status and whether it went silent or stalled, and the
+// verdict against the thresholds of its config (configs/monitor.yaml). With --replay it judges a
+// recorded run the same way, without the checks of time. Exits 0 unless LCM failed or the summary
+// could not be written; the summary's "ok" tells whether the run was clean.
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -36,9 +38,10 @@ int main(int argc, char** argv) {
   traverse::MonitorConfig cfg;
   std::string out_path;
   proc.cli().add_option("--out", out_path, "JSON summary written at shutdown");
+  proc.offer_replay();  // judges a recorded run (offline): no status gaps nor silence
   if (auto rc = proc.start(argc, argv, cfg)) return *rc;
 
-  traverse::MonitorNode node(proc.bus(), cfg);
+  traverse::MonitorNode node(proc.bus(), cfg, proc.name(), !proc.replaying());
   int rc = proc.spin([&] { proc.counter("events") = static_cast<double>(node.events()); });
 
   const auto summary = node.summary(traverse::now_utime());

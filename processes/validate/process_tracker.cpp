@@ -4,7 +4,11 @@
 
 namespace traverse::validate {
 
-bool said_stopping(const std::string& state) { return state.rfind("stopping", 0) == 0; }
+bool said_stopping(const std::string& state) {
+  // "stopped" is the last status a process sends after its shutdown work (an export): a
+  // process heard saying it was not silent afterwards, whatever the time since.
+  return state.rfind("stopping", 0) == 0 || state.rfind("stopped", 0) == 0;
+}
 
 void ProcessTracker::add(const std::string& channel, int64_t receive_utime,
                          const ProcessReport& report) {
@@ -13,8 +17,11 @@ void ProcessTracker::add(const std::string& channel, int64_t receive_utime,
   if (p.statuses == 0) {
     p.first_heard_utime = receive_utime;
   } else {
+    // After "stopping" a process does its shutdown work (an export) without statuses.
     const double gap_s = 1e-6 * (receive_utime - p.last_heard_utime);
-    p.max_status_gap_s = std::max(p.max_status_gap_s.value_or(gap_s), gap_s);
+    if (!said_stopping(p.last.state)) {
+      p.max_status_gap_s = std::max(p.max_status_gap_s.value_or(gap_s), gap_s);
+    }
     if (report.pid != p.last.pid) {
       ++p.restarts;
     } else if (report.seq > p.last.seq + 1) {

@@ -24,6 +24,11 @@ struct ProcessReport {
   // Sums over the process's channels since it started [messages].
   int64_t received = 0, published = 0, decode_failures = 0, out_of_order = 0, missed = 0,
           handler_errors = 0;
+  // From its counters: messages rejected (cannot be right, beyond a limit) and stamps dropped as
+  // far from their neighbours, summed over channels; what its receive queue dropped; for an
+  // offline run, the events it replayed and the damaged records met in its input (-1: live).
+  int64_t rejected = 0, stamp_outliers = 0, queue_dropped = 0;
+  int64_t replay_events = -1, replay_damaged_records = -1;
 };
 
 struct ProcessSummary {
@@ -56,7 +61,7 @@ class ProcessTracker {
   std::map<std::string, ProcessSummary> processes_;
 };
 
-// True when the process said it was stopping, i.e. it ended on purpose.
+// True when the process said it was stopping or had stopped, i.e. it ended on purpose.
 bool said_stopping(const std::string& state);
 
 }  // namespace traverse::validate

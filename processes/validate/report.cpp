@@ -36,15 +36,43 @@ std::vector<std::string> channel_problems(const ChannelSummaries& channels) {
                     ", message utime " + std::to_string(c.utime_backwards) + ", up to " +
                     format("%.6f", c.max_backstep_s.value_or(0.0)) + " s)");
     }
+    if (c.rejected > 0) {
+      out.push_back(name + ": " + std::to_string(c.rejected) + " messages cannot be right (" +
+                    c.first_rejection + ")");
+    }
+    if (c.stamp_outliers > 0) {
+      out.push_back(name + ": " + std::to_string(c.stamp_outliers) +
+                    " messages stamped far from their neighbours");
+    }
   }
   return out;
 }
 
-std::vector<std::string> process_problems(const ProcessSummaries& processes) {
+std::vector<std::string> process_problems(const ProcessSummaries& processes, const Thresholds& t) {
   std::vector<std::string> out;
+  const auto over = [&out](const std::string& name, int64_t n, int64_t max, const char* what) {
+    if (n > max) {
+      out.push_back(name + ": " + std::to_string(n) + " " + what + " (at most " +
+                    std::to_string(max) + " allowed)");
+    }
+  };
   for (const auto& [name, p] : processes) {
-    if (p.state == "silent") {
+    if (t.timing && p.state == "silent") {
       out.push_back(name + ": silent for " + format("%.1f", p.silent_s) + " s");
+    }
+    if (t.timing && p.max_status_gap_s && *p.max_status_gap_s > t.max_status_gap_s) {
+      out.push_back(name + ": no status for " + format("%.1f", *p.max_status_gap_s) +
+                    " s at one point (at most " + format("%.1f", t.max_status_gap_s) + " s)");
+    }
+    over(name, p.last.missed, t.max_missed, "messages missed (sequence numbers skipped)");
+    over(name, p.last.out_of_order, t.max_out_of_order, "messages dropped as out of order");
+    over(name, p.last.queue_dropped, t.max_queue_dropped, "messages dropped by its receive queue");
+    over(name, p.last.rejected + p.last.stamp_outliers, t.max_rejected,
+         "messages rejected as implausible, beyond a limit or stamped far from their neighbours");
+    if (p.last.replay_events == 0) out.push_back(name + ": its input log had no readable event");
+    if (p.last.replay_damaged_records > 0) {
+      out.push_back(name + ": its input log has " + std::to_string(p.last.replay_damaged_records) +
+                    " damaged records");
     }
     if (p.last.decode_failures > 0) {
       out.push_back(name + ": reports " + std::to_string(p.last.decode_failures) +
@@ -78,6 +106,9 @@ void write_channels(JsonWriter& json, const ChannelSummaries& channels) {
     json.key("other_types").begin_object();
     for (const auto& [type, n] : c.other_types) json.field(type, n);
     json.end_object();
+    json.field("rejected", c.rejected);
+    json.field("stamp_outliers", c.stamp_outliers);
+    json.field("time_jumps", c.time_jumps);
     auto opt = [](const Range& r, int64_t v) { return r.empty ? std::optional<int64_t>() : v; };
     json.field("points_per_scan_min", opt(c.points, c.points.min));
     json.field("points_per_scan_max", opt(c.points, c.points.max));
@@ -121,6 +152,9 @@ void write_processes(JsonWriter& json, const ProcessSummaries& processes) {
     json.field("out_of_order", p.last.out_of_order);
     json.field("missed", p.last.missed);
     json.field("handler_errors", p.last.handler_errors);
+    json.field("rejected", p.last.rejected);
+    json.field("stamp_outliers", p.last.stamp_outliers);
+    json.field("queue_dropped", p.last.queue_dropped);
     json.end_object();
   }
   json.end_object();

@@ -17,9 +17,19 @@ using ProcessSummaries = std::map<std::string, ProcessSummary>;
 
 // One sentence per problem: decode failures and timestamps going backwards on a channel.
 std::vector<std::string> channel_problems(const ChannelSummaries& channels);
-// One sentence per problem: silent processes, and decode failures or handler errors a process
-// reports in its status.
-std::vector<std::string> process_problems(const ProcessSummaries& processes);
+// What a run may lose before it fails (MonitorConfig in monitor_node.hpp gives them from the
+// config); `timing`: judge status gaps and silence (a live run, not a replay).
+struct Thresholds {
+  bool timing = true;
+  double max_status_gap_s = 3.0;
+  int64_t max_missed = 0, max_out_of_order = 0, max_queue_dropped = 0, max_rejected = 0,
+          max_seq_gaps = 0;
+};
+
+// One sentence per problem: silent or stalled processes, decode failures or handler errors a
+// process reports in its status, and losses beyond the thresholds.
+std::vector<std::string> process_problems(const ProcessSummaries& processes,
+                                          const Thresholds& t = {});
 
 // Writes the key "channels" and an object with one entry per channel.
 void write_channels(JsonWriter& json, const ChannelSummaries& channels);

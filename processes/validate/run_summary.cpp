@@ -2,9 +2,15 @@
 
 namespace traverse::validate {
 
-void judge(RunSummary& s) {
+void judge(RunSummary& s, const Thresholds& t) {
   s.problems = channel_problems(s.channels);
-  for (auto& p : process_problems(s.processes)) s.problems.push_back(std::move(p));
+  for (const auto& [name, c] : s.channels) {
+    if (c.seq_gaps > t.max_seq_gaps) {
+      s.problems.push_back(name + ": the monitor missed " + std::to_string(c.seq_gaps) +
+                           " messages (sequence numbers skipped)");
+    }
+  }
+  for (auto& p : process_problems(s.processes, t)) s.problems.push_back(std::move(p));
   if (s.status_decode_failures > 0) {
     s.problems.push_back(std::to_string(s.status_decode_failures) +
                          " messages on STATUS_ channels are not a process status");

@@ -23,7 +23,7 @@ struct RunSummary {
 };
 
 // Fills problems and ok from the channels and processes.
-void judge(RunSummary& s);
+void judge(RunSummary& s, const Thresholds& t = {});
 
 // One line of JSON: lcm_url, duration_s, events, channels, processes, problems, ok.
 std::string to_json(const RunSummary& s);

@@ -1,7 +1,6 @@
 #include "stream_analyzer.hpp"
 
 #include <algorithm>
-#include <exception>
 
 namespace traverse::validate {
 
@@ -14,6 +13,8 @@ void Range::add(int64_t v) {
 void StreamAnalyzer::TypeStream::add(const MessageFacts& f, bool event_went_back) {
   ++decoded;
   if (f.utime) {
+    const StampOrder::Step step = order.next(*f.utime);
+    (void)step;  // counted by the StampOrder itself
     if (last_utime && *f.utime < *last_utime) {
       ++utime_backwards;
       if (!event_went_back) ++utime_only_backwards;
@@ -50,25 +51,31 @@ void StreamAnalyzer::add(const std::string& channel, int64_t event_utime, const 
   c.last_event = event_utime;
   ++c.count;
 
-  const TypeInfo* type = find_type(data, size);
+  const TypeInfo* type = type_of_fingerprint(data, size);
   if (!type) {
     ++c.unknown_fingerprint;
     return;
   }
-  MessageFacts facts;
-  bool ok = false;
-  try {
-    // Corrupt array lengths make generated decoders throw (negative sizes, bad_alloc).
-    ok = size <= static_cast<std::size_t>(INT32_MAX) &&
-         type->inspect(data, static_cast<int>(size), facts);
-  } catch (const std::exception&) {
-    ok = false;
+  Inspection r;
+  if (size <= static_cast<std::size_t>(INT32_MAX)) {
+    // The bytes are walked before anything is decoded (message_layout.hpp): a message claiming
+    // more than it holds costs nothing.
+    r = type->inspect(data, static_cast<int>(size), limits_);
   }
-  if (!ok) {
+  if (r.verdict == MessageVerdict::kMalformed) {
     ++c.undecodable;
     return;
   }
-  c.types[type->name].add(facts, event_went_back);
+  if (r.verdict != MessageVerdict::kGood) {
+    ++c.rejected;
+    if (c.first_rejection.empty()) c.first_rejection = r.problem;
+  }
+  TypeStream& t = c.types.try_emplace(type->name, max_stamp_jump_us_).first->second;
+  if (r.verdict == MessageVerdict::kOverLimit) {
+    ++t.decoded;  // holds what it claims, but was not decoded: no facts
+  } else {
+    t.add(r.facts, event_went_back);
+  }
 }
 
 std::map<std::string, ChannelSummary> StreamAnalyzer::summary() const {
@@ -86,6 +93,8 @@ std::map<std::string, ChannelSummary> StreamAnalyzer::summary() const {
     if (c.max_backstep_us) s.max_backstep_s = 1e-6 * static_cast<double>(*c.max_backstep_us);
     s.unknown_fingerprint = c.unknown_fingerprint;
     s.undecodable = c.undecodable;
+    s.rejected = c.rejected;
+    s.first_rejection = c.first_rejection;
 
     // The channel's type is the one most of its messages decode as (first by name on a tie).
     const TypeStream* main = nullptr;
@@ -106,6 +115,11 @@ std::map<std::string, ChannelSummary> StreamAnalyzer::summary() const {
       s.max_backstep_s = std::max(s.max_backstep_s.value_or(0.0),
                                   1e-6 * static_cast<double>(*main->max_backstep_us));
     }
+    // A message still held at the end jumped far from its predecessor with none after it.
+    StampOrder order = main->order;
+    order.finish();
+    s.stamp_outliers = order.outliers();
+    s.time_jumps = order.jumps();
     s.seq_gaps = main->seq_gaps;
     s.seq_restarts = main->seq_restarts;
     s.points = main->points;

@@ -7,7 +7,10 @@
 // type's fingerprint, or bytes that do not decode) is a decode failure. Per channel it counts
 // messages, the mean rate and largest gap of the event times, timestamps going backwards (event
 // time, and the message's own utime where the type has one), skipped sequence numbers, and the
-// facts the registry extracts (points per scan, sweep time, frames).
+// facts the registry extracts (points per scan, sweep time, frames). A message whose bytes do not
+// hold what it claims is never decoded (message_layout.hpp); one that decodes but cannot be right
+// or exceeds a limit is counted as rejected, as a subscriber would reject it (message_checks.hpp);
+// stamps far from their neighbours are counted as a subscriber would drop them (stamp_order.hpp).
 //
 // Memory is bounded by the number of channels and types, never by the number of messages, so a
 // log of any size streams through.
@@ -19,7 +22,10 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
+#include "input_config.hpp"
+#include "stamp_order.hpp"
 #include "type_registry.hpp"
 
 namespace traverse::validate {
@@ -50,18 +56,29 @@ struct ChannelSummary {
   int64_t unknown_fingerprint = 0;       // [messages] of those: fingerprint of no known type
   int64_t undecodable = 0;  // [messages] of those: known fingerprint, bytes do not decode
   std::map<std::string, int64_t> other_types;  // of those: [messages] decoding as another type
-  Range points;                                // [points] per message, types with n_ranges
-  Range sweep_us;                              // [us] utime_last - utime_first, types with both
-  std::optional<double> period_s;              // [s] mean step of the message utime
-  std::set<std::string> frames;                // frames named by the messages (at most kMaxFrames)
+  int64_t rejected = 0;         // [messages] cannot be right or beyond a limit (message_checks.hpp)
+  std::string first_rejection;  // why the first of those was rejected
+  int64_t stamp_outliers = 0;   // [messages] utime far from both neighbours (stamp_order.hpp)
+  int64_t time_jumps = 0;       // [messages] utime jumped far and the stream went on from there
+  Range points;                 // [points] per message, types with n_ranges
+  Range sweep_us;               // [us] utime_last - utime_first, types with both
+  std::optional<double> period_s;  // [s] mean step of the message utime
+  std::set<std::string> frames;    // frames named by the messages (at most kMaxFrames)
 
-  bool clean() const { return decode_failures == 0 && backwards == 0; }
+  bool clean() const {
+    return decode_failures == 0 && backwards == 0 && rejected == 0 && stamp_outliers == 0;
+  }
 };
 
 inline constexpr std::size_t kMaxFrames = 8;
 
 class StreamAnalyzer {
  public:
+  // Limits and the stamp jump as every process applies them (input_config.hpp).
+  explicit StreamAnalyzer(const InputConfig& input = {})
+      : limits_(array_limits(input)),
+        max_stamp_jump_us_(static_cast<int64_t>(1e6 * input.max_stamp_jump_s)) {}
+
   // Feeds one event. `event_utime` [us] is the log's event time or the receive time.
   void add(const std::string& channel, int64_t event_utime, const void* data, std::size_t size);
 
@@ -71,7 +88,9 @@ class StreamAnalyzer {
  private:
   // What the messages of one type on one channel said about themselves.
   struct TypeStream {
+    explicit TypeStream(int64_t max_jump_us) : order(max_jump_us) {}
     int64_t decoded = 0;
+    StampOrder order;  // what a subscriber would deliver, hold back or drop
     std::optional<int64_t> first_utime, last_utime, last_seq;
     int64_t utime_backwards = 0;
     int64_t utime_only_backwards = 0;  // utime went back, the event time did not
@@ -89,9 +108,13 @@ class StreamAnalyzer {
     std::optional<int64_t> max_gap_us, max_backstep_us;
     int64_t undecodable = 0;  // fingerprint known but bytes do not decode
     int64_t unknown_fingerprint = 0;
+    int64_t rejected = 0;
+    std::string first_rejection;
     std::map<std::string, TypeStream> types;  // by type name
   };
 
+  std::vector<ArrayLimit> limits_;
+  int64_t max_stamp_jump_us_;
   std::map<std::string, Channel> channels_;
   int64_t events_ = 0;
 };

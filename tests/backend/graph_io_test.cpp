@@ -74,6 +74,39 @@ TEST(GraphIo, BadLinesNameTheLine) {
   EXPECT_NE(r.error.find("test.g2o:1:"), std::string::npos) << r.error;
 }
 
+TEST(GraphIo, InformationNotPositiveDefiniteNamesTheEdgesLine) {
+  const auto r = parse(
+      "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n# a comment\n"
+      "EDGE_SE2 0 1 1 0 0 -1000 0 0 1000 0 1000\n");
+  EXPECT_FALSE(r.graph);
+  EXPECT_NE(r.error.find("test.g2o:4: information matrix of edge 0 -> 1 is not positive definite"),
+            std::string::npos)
+      << r.error;
+}
+
+TEST(GraphIo, EmptyFileSaysSo) {
+  for (const char* text : {"", "\n# nothing\n"}) {
+    const auto r = parse(text);
+    EXPECT_FALSE(r.graph);
+    EXPECT_NE(r.error.find("no vertices and no edges"), std::string::npos) << r.error;
+  }
+}
+
+TEST(GraphIo, EdgesAloneAreInitialisedAlongASpanningTree) {
+  // The SE-Sync graphs have no VERTEX lines.
+  const auto r = parse(
+      "EDGE_SE2 4 7 1 0 1.5707963267948966 1 0 0 1 0 1\n"
+      "EDGE_SE2 7 9 2 0 0 1 0 0 1 0 1\n");
+  ASSERT_TRUE(r.graph) << r.error;
+  EXPECT_TRUE(r.initialised_from_edges);
+  const PoseGraph& g = *r.graph;
+  EXPECT_EQ(g.ids, (std::vector<int64_t>{4, 7, 9}));
+  EXPECT_NEAR(g.poses[2].x(), 1.0, 1e-12);  // 1 m ahead, turned left, then 2 m ahead
+  EXPECT_NEAR(g.poses[2].y(), 2.0, 1e-12);
+  // With vertex lines, an edge to an undefined vertex stays an error.
+  EXPECT_FALSE(parse("VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 9 1 0 0 1 0 0 1 0 1\n").graph);
+}
+
 TEST(GraphIo, MissingFileIsAnError) {
   const auto r = read_pose_graph(std::string("/nonexistent/graph.g2o"));
   EXPECT_FALSE(r.graph);

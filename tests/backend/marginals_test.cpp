@@ -111,13 +111,27 @@ TEST(Marginals, OdometryChainVarianceGrowsLinearlyInSquareMetres) {
 }
 
 TEST(Marginals, SingularInformationIsReported) {
-  PoseGraph g;  // vertex 2 has no edge: it is unconstrained
+  PoseGraph g;  // the only edge says nothing about the heading of vertex 1
+  g.add_vertex(0, Pose2());
+  g.add_vertex(1, Pose2(1.0, 0.0, 0.0));
+  Eigen::Matrix3d no_heading = Eigen::Matrix3d::Identity();
+  no_heading(2, 2) = 0.0;
+  g.edges.push_back({0, 1, Pose2(1.0, 0.0, 0.0), no_heading});
+  SpaOptimizer optimizer;
+  EXPECT_FALSE(optimizer.marginals(g));
+}
+
+TEST(Marginals, AVertexWithoutEdgesIsItsOwnFixedComponent) {
+  PoseGraph g;
   g.add_vertex(0, Pose2());
   g.add_vertex(1, Pose2(1.0, 0.0, 0.0));
   g.add_vertex(2, Pose2(2.0, 0.0, 0.0));
   g.edges.push_back({0, 1, Pose2(1.0, 0.0, 0.0), Eigen::Matrix3d::Identity()});
   SpaOptimizer optimizer;
-  EXPECT_FALSE(optimizer.marginals(g));
+  const auto cov = optimizer.marginals(g);
+  ASSERT_TRUE(cov);
+  EXPECT_EQ((*cov)[2], Eigen::Matrix3d::Zero());
+  EXPECT_GT((*cov)[1](0, 0), 0.0);
 }
 
 }  // namespace

@@ -84,6 +84,7 @@ TEST(PoseGraph, FixesFirstVertexOnlyWhenNoneFixed) {
   PoseGraph g;
   g.add_vertex(10, Pose2());
   g.add_vertex(11, Pose2(), true);
+  g.edges.push_back({0, 1, Pose2(), Eigen::Matrix3d::Identity()});
   g.fix_gauge_if_free();
   EXPECT_FALSE(g.fixed[0]);
   g.fixed[1] = false;
@@ -91,6 +92,48 @@ TEST(PoseGraph, FixesFirstVertexOnlyWhenNoneFixed) {
   EXPECT_TRUE(g.fixed[0]);
   EXPECT_EQ(g.index_of(11), 1);
   EXPECT_EQ(g.index_of(12), -1);
+}
+
+TEST(PoseGraph, FixesOneVertexPerComponent) {
+  // Two chains that share no edge: a gauge for each, else H is singular (the free component's
+  // marginals came out as 4.7e28 m^2).
+  PoseGraph g;
+  for (int k = 0; k < 5; ++k) g.add_vertex(k, Pose2(k, 0, 0));
+  g.edges.push_back({0, 1, Pose2(1, 0, 0), Eigen::Matrix3d::Identity()});
+  g.edges.push_back({3, 2, Pose2(-1, 0, 0), Eigen::Matrix3d::Identity()});
+  g.edges.push_back({3, 4, Pose2(1, 0, 0), Eigen::Matrix3d::Identity()});
+  int count = 0;
+  EXPECT_EQ(components(g, &count), (std::vector<int>{0, 0, 1, 1, 1}));
+  EXPECT_EQ(count, 2);
+  g.fix_gauge_if_free();
+  EXPECT_EQ(g.fixed, (std::vector<bool>{true, false, true, false, false}));
+}
+
+TEST(PoseGraph, InitialisesFromEdgesAlongASpanningTree) {
+  PoseGraph g;
+  for (int k = 0; k < 3; ++k) g.add_vertex(k, Pose2());
+  g.edges.push_back({0, 1, Pose2(1, 0, M_PI / 2), Eigen::Matrix3d::Identity()});
+  g.edges.push_back({2, 1, Pose2(0, -1, 0), Eigen::Matrix3d::Identity()});  // against the tree
+  initialise_from_edges(g);
+  EXPECT_NEAR(g.poses[1].x(), 1.0, 1e-12);
+  EXPECT_NEAR(g.poses[1].theta(), M_PI / 2, 1e-12);
+  // T_w2 = T_w1 (T_21)^-1: vertex 1 is 1 m to the right of vertex 2, so 2 is 1 m left of 1.
+  EXPECT_NEAR(g.poses[2].x(), 1.0 - 1.0, 1e-12);
+  EXPECT_NEAR(g.poses[2].y(), 0.0, 1e-12);
+  EXPECT_NEAR(g.poses[2].theta(), M_PI / 2, 1e-12);
+}
+
+TEST(PoseGraph, PositiveDefiniteInformation) {
+  EXPECT_TRUE(positive_definite(Eigen::Matrix3d::Identity()));
+  Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+  m(0, 0) = -1000;
+  EXPECT_FALSE(positive_definite(m));
+  m = Eigen::Matrix3d::Identity();
+  m(2, 2) = 0;  // semi-definite: rotation unconstrained
+  EXPECT_FALSE(positive_definite(m));
+  m = Eigen::Matrix3d::Identity();
+  m(0, 1) = 5;  // not symmetric
+  EXPECT_FALSE(positive_definite(m));
 }
 
 }  // namespace

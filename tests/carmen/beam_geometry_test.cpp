@@ -8,7 +8,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "carmen_log.hpp"
+#include "log_reader.hpp"
 
 namespace traverse::carmen {
 namespace {

@@ -65,7 +65,8 @@ TEST(Bus, DropsOutOfOrderAndCountsMissedSequenceNumbers) {
   std::vector<int64_t> utimes;
   bus.subscribe<pose2d_t>("POSE", [&](const pose2d_t& p) { utimes.push_back(p.utime); });
   // Hand-made sequence numbers: 0, 1, 5 (3 missed), and a message going back in time.
-  std::vector<std::pair<int64_t, int64_t>> seq_utime = {{0, 10}, {1, 20}, {5, 30}, {6, 25}, {7, 40}};
+  std::vector<std::pair<int64_t, int64_t>> seq_utime = {
+      {0, 10}, {1, 20}, {5, 30}, {6, 25}, {7, 40}};
   for (auto [seq, utime] : seq_utime) {
     auto p = pose_at(utime);
     p.seq = seq;
@@ -123,6 +124,8 @@ TEST(Bus, NetworkBusQueuesWhatArrivesWhileAHandlerIsBusy) {
   });
   planar_scan_t scan{};
   scan.frame = "laser";
+  scan.angle_step = 1e-4f;
+  scan.range_max = 30.0f;
   scan.n_ranges = 25'000;  // 100 KB
   scan.ranges.assign(scan.n_ranges, 1.0f);
   for (int i = 0; i < kMessages; ++i) {

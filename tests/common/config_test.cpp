@@ -71,12 +71,22 @@ TEST(Config, UnknownKeyNamesKeyAndFile) {
   EXPECT_EQ(error_of("grid:\n  resolution: 0.1\n"), "test.yaml: unknown key 'grid.resolution'");
 }
 
+TEST(Config, ARepeatedKeyNamesKeyAndFile) {
+  // YAML parsers keep the first of two equal keys: the second was ignored without a word.
+  EXPECT_EQ(error_of("frame: a\ndeskew: true\nframe: b\n"), "test.yaml: key 'frame' appears twice");
+  EXPECT_EQ(error_of("grid:\n  levels: 2\n  levels: 5\n"),
+            "test.yaml: key 'grid.levels' appears twice");
+}
+
+TEST(Config, AMappingAsKeyIsAnErrorNotACrash) { EXPECT_NE(error_of("? [a, b]\n: 1\n"), ""); }
+
 TEST(Config, MistypedValueNamesKey) {
   EXPECT_EQ(error_of("grid:\n  levels: many\n"),
             "test.yaml: key 'grid.levels' expects an integer, got 'many'");
   EXPECT_EQ(error_of("grid:\n  levels: 2.5\n"),
             "test.yaml: key 'grid.levels' expects an integer, got '2.5'");
-  EXPECT_EQ(error_of("deskew: maybe\n"), "test.yaml: key 'deskew' expects true or false, got 'maybe'");
+  EXPECT_EQ(error_of("deskew: maybe\n"),
+            "test.yaml: key 'deskew' expects true or false, got 'maybe'");
   EXPECT_EQ(error_of("grid: 3\n"), "test.yaml: key 'grid' expects a mapping of keys, got '3'");
   EXPECT_EQ(error_of("extrinsic: [1, a]\n"),
             "test.yaml: key 'extrinsic[1]' expects a finite number, got 'a'");

@@ -90,6 +90,39 @@ TEST_F(LcmLogTest, CorruptHeaderIsSkippedAndReadingResumes) {
   EXPECT_EQ(r.damage()[0].skipped_bytes, all[5].offset - all[4].offset);
 }
 
+// Sets the data length field of the record at `offset` to its value plus `delta`.
+void change_data_length(const fs::path& path, uint64_t offset, int delta) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekg(static_cast<std::streamoff>(offset + 24));
+  unsigned char b[4];
+  f.read(reinterpret_cast<char*>(b), 4);
+  uint32_t len = (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3];
+  len += static_cast<uint32_t>(delta);
+  for (int i = 0; i < 4; ++i) b[i] = static_cast<unsigned char>(len >> (24 - 8 * i));
+  f.seekp(static_cast<std::streamoff>(offset + 24));
+  f.write(reinterpret_cast<char*>(b), 4);
+}
+
+TEST_F(LcmLogTest, RecordLengthCorruptionIsReportedWhereItIs) {
+  std::vector<LogEvent> all;
+  {
+    LogReader r(path_.string());
+    all = read_all(r);
+  }
+  for (int delta : {+10, -10, +100000}) {
+    SetUp();
+    change_data_length(path_, all[4].offset, delta);
+    LogReader r(path_.string());
+    const auto evs = read_all(r);
+    EXPECT_EQ(evs.size(), 9u) << delta;  // record 5 alone is lost
+    ASSERT_EQ(r.damage().size(), 1u) << delta;
+    EXPECT_EQ(r.damage()[0].offset, all[4].offset) << delta << ": " << r.damage()[0].what;
+    EXPECT_NE(r.damage()[0].what.find("record length"), std::string::npos) << r.damage()[0].what;
+    EXPECT_EQ(r.damage()[0].skipped_bytes, all[5].offset - all[4].offset) << delta;
+    EXPECT_EQ(evs[4].offset, all[5].offset);
+  }
+}
+
 TEST(LcmLog, MissingFileThrows) {
   EXPECT_THROW(LogReader("/nonexistent/x.lcmlog"), std::runtime_error);
 }

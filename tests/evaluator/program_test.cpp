@@ -1,4 +1,5 @@
 // The offline program end to end: a small log written here, traverse-evaluator run on it.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -66,6 +67,13 @@ double json_number(const std::string& json, const std::string& key) {
 
 class EvaluatorProgram : public ::testing::Test {
  protected:
+  // A config that scores an estimate however little of the reference it covers.
+  std::string any_share_config() const {
+    const fs::path cfg = dir_ / "any-share.yaml";
+    std::ofstream(cfg) << "min_reference_share: 0.0\n";
+    return cfg.string();
+  }
+
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
            ("traverse_evaluator_test_" + std::to_string(::getpid()) + "_" +
@@ -270,7 +278,9 @@ TEST_F(EvaluatorProgram, DenseSegmentsNewestRevision) {
     out.publish("DENSE_SEGMENTS", m2);
     out.publish("DENSE_SEGMENTS", m3);
   }
-  const RunResult r = run("--log " + log + " --estimate DENSE_SEGMENTS --align none");
+  // Three segments cover 3 s of the 10 s of truth: scored all the same (min_reference_share 0).
+  const RunResult r = run("--log " + log + " --estimate DENSE_SEGMENTS --align none --config " +
+                          any_share_config());
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
   EXPECT_EQ(json_value(r.last_line, "estimate_type"), "\"dense_segments_t\"");
   EXPECT_EQ(json_number(r.last_line, "dense_segments"), 3);
@@ -291,12 +301,121 @@ TEST_F(EvaluatorProgram, MixedTypesOnTheEstimateChannelAreReported) {
     out.publish("KEY_POSES", stray);
     out.publish("KEY_POSES", stray);
   }
-  const RunResult r = run("--log " + mixed + " --estimate KEY_POSES --align none 2>/dev/null");
+  const RunResult r = run("--log " + mixed + " --estimate KEY_POSES --align none --config " +
+                          any_share_config() + " 2>/dev/null");
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
   EXPECT_EQ(json_value(r.last_line, "estimate_type"), "\"key_poses_t\"");
   EXPECT_EQ(json_number(r.last_line, "mixed_type_messages"), 2);
   EXPECT_EQ(json_number(r.last_line, "estimate_poses"), 2);
   EXPECT_EQ(json_value(r.last_line, "position_max_m"), "0.000000");
+}
+
+// The "perfect run": a log of 237 scans whose stamps carried no time, a backend that
+// published a single key pose. One reference pose of 237 covered: refused, not RMSE 0.
+TEST(EvaluatorProgramCoverage, ASinglePoseIsAFailureNotAPerfectRun) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("traverse_evaluator_coverage_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string log = (dir / "run.lcmlog").string();
+  {
+    LogFilePublisher out(log);
+    for (int i = 0; i < 237; ++i) {
+      pose2d_t ref{};
+      ref.utime = 3'000'000 * (i + 1);
+      ref.x = 0.5 * i;
+      out.publish("POSE_REFERENCE", ref);
+      if (i == 0) out.publish("POSE_BACKEND", ref);
+    }
+  }
+  const RunResult r = run("--log " + log + " --estimate POSE_BACKEND --reference POSE_REFERENCE");
+  EXPECT_EQ(r.exit_code, 1) << r.last_line;
+  EXPECT_EQ(json_number(r.last_line, "matched"), 1);
+  EXPECT_EQ(json_number(r.last_line, "reference_covered"), 1);
+  EXPECT_NEAR(json_number(r.last_line, "reference_share"), 1.0 / 237, 1e-4);
+  EXPECT_EQ(json_value(r.last_line, "refused"), "true");
+  EXPECT_EQ(json_value(r.last_line, "position_rmse_m"), "null");
+  EXPECT_EQ(json_value(r.last_line, "max_jump_m"), "null");
+  fs::remove_all(dir);
+}
+
+TEST_F(EvaluatorProgram, PartialCoverageIsRefusedFullIsNot) {
+  // The frontend's poses cover all 10 s of truth: scored.
+  const RunResult full = run("--log " + log_);
+  EXPECT_EQ(full.exit_code, 0) << full.last_line;
+  EXPECT_EQ(json_value(full.last_line, "refused"), "false");
+  EXPECT_NEAR(json_number(full.last_line, "reference_share"), 1.0, 1e-3);
+  EXPECT_EQ(json_number(full.last_line, "min_reference_share"), 0.8);
+  // A stage that stopped after 7 s: 70 % of the truth, refused by default, scored at 0.6.
+  const std::string partial = (dir_ / "partial.lcmlog").string();
+  {
+    LogFilePublisher out(partial);
+    for (const StampedPose& p : test::circle_truth(10)) {
+      pose2d_t msg{};
+      msg.utime = p.utime;
+      msg.x = p.pose.x();
+      msg.y = p.pose.y();
+      msg.theta = p.pose.theta();
+      out.publish("POSE_GROUND_TRUTH", msg);
+      if (p.utime <= 7'800'000) out.publish("POSE_FRONTEND", msg);
+    }
+  }
+  const RunResult refused = run("--log " + partial + " 2>/dev/null");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_EQ(json_value(refused.last_line, "refused"), "true");
+  EXPECT_NEAR(json_number(refused.last_line, "reference_share"), 0.68, 0.01);
+  const fs::path cfg = dir_ / "share.yaml";
+  std::ofstream(cfg) << "min_reference_share: 0.6\n";
+  const RunResult lenient = run("--log " + partial + " --config " + cfg.string());
+  EXPECT_EQ(lenient.exit_code, 0) << lenient.last_line;
+  EXPECT_EQ(json_value(lenient.last_line, "position_max_m"), "0.000000");
+}
+
+// --relations on a log: relations between scans 1 s apart, each 2 cm longer in x than the truth
+// (relations_test.cpp checks the metric on varied errors; this checks the program: channels,
+// counts, keys, CSV, exit codes).
+TEST_F(EvaluatorProgram, RelationsModeScoresTheEstimateChannel) {
+  const fs::path rel = dir_ / "run.relations";
+  {
+    std::ofstream out(rel);
+    const auto truth = test::circle_truth(10);
+    for (std::size_t i = 0; i + 200 < truth.size(); i += 25) {  // frontend scans, 1 s apart
+      const Pose2 d = between(truth[i].pose, truth[i + 200].pose);
+      out << fmt::format("{}.{:06d} {}.{:06d} {:.9f} {:.9f} 0 0 0 {:.9f}\n",
+                         truth[i].utime / 1'000'000, truth[i].utime % 1'000'000,
+                         truth[i + 200].utime / 1'000'000, truth[i + 200].utime % 1'000'000,
+                         d.x() + 0.02, d.y(), d.theta());
+    }
+    out << "1.000000 999.000000 0 0 0 0 0 0\n";  // a stamp no scan has: missing
+  }
+  const RunResult truth = run("--log " + log_ + " --estimate POSE_GROUND_TRUTH --relations " +
+                              rel.string() + " --out " + (dir_ / "out").string());
+  ASSERT_EQ(truth.exit_code, 0) << truth.last_line;
+  EXPECT_EQ(json_value(truth.last_line, "mode"), "\"relations\"");
+  EXPECT_EQ(json_number(truth.last_line, "relations"), 74);
+  EXPECT_EQ(json_number(truth.last_line, "relations_used"), 73);
+  EXPECT_EQ(json_number(truth.last_line, "relations_missing"), 1);
+  // Every relation 2 cm longer in x than the truth: 0.02 m back, the same for all.
+  EXPECT_NEAR(json_number(truth.last_line, "trans_mean_m"), 0.02, 2e-6);
+  EXPECT_NEAR(json_number(truth.last_line, "trans_sd_m"), 0.0, 2e-6);
+  EXPECT_NEAR(json_number(truth.last_line, "trans_sq_mean_m2"), 4e-4, 1e-7);
+  EXPECT_NEAR(json_number(truth.last_line, "rot_mean_deg"), 0.0, 1e-6);
+  EXPECT_EQ(json_value(truth.last_line, "estimate_channel"), "\"POSE_GROUND_TRUTH\"");
+  std::ifstream csv(dir_ / "out" / "relations.csv");
+  int rows = -1;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  EXPECT_EQ(rows, 74);
+  // The frontend channel (every 25th truth pose, all 0.3 m off in x: a shift of the whole
+  // trajectory, which no relative pose sees): the same relations, the same errors.
+  const RunResult frontend = run("--log " + log_ + " --relations " + rel.string());
+  EXPECT_EQ(frontend.exit_code, 0) << frontend.last_line;
+  EXPECT_EQ(json_number(frontend.last_line, "relations_used"), 73);
+  EXPECT_NEAR(json_number(frontend.last_line, "trans_mean_m"), 0.02, 2e-6);
+  // A channel with nothing on it: refused, exit 1, figures null.
+  const RunResult none =
+      run("--log " + log_ + " --estimate POSE_DENSE --relations " + rel.string() + " 2>/dev/null");
+  EXPECT_EQ(none.exit_code, 1);
+  EXPECT_EQ(json_value(none.last_line, "refused"), "true");
+  EXPECT_EQ(json_value(none.last_line, "trans_mean_m"), "null");
 }
 
 TEST(EvaluatorProgramArgs, BadAlignIsAConfigError) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include "../backend/test_graphs.hpp"
@@ -91,7 +92,7 @@ TEST_F(PgoProgram, OptimisesWritesGraphAndMarginals) {
   std::ifstream in(csv);
   std::string header, line;
   std::getline(in, header);
-  EXPECT_EQ(header.rfind("id,x_m,y_m,theta_rad,cov_xx_m2", 0), 0u);
+  EXPECT_EQ(header.rfind("id,component,x_m,y_m,theta_rad,cov_xx_m2", 0), 0u);
   int rows = 0;
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 100);
@@ -144,6 +145,83 @@ TEST_F(PgoProgram, BadFileNamesTheLine) {
   const ProgramRun r = run(pgo_ + " " + bad);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.out.find("bad.g2o:3:"), std::string::npos) << r.out;
+}
+
+TEST_F(PgoProgram, RefusesAnInformationMatrixNotPositiveDefiniteNamingTheLine) {
+  // Before: "converged": true, chi2 4e11, poses 45 km away, exit 0.
+  const std::string path = (dir_ / "bad.g2o").string();
+  std::ofstream(path) << "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\n"
+                         "EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\n"
+                         "EDGE_SE2 1 2 1 0 0 -1000 0 0 1000 0 1000\n";
+  const ProgramRun r = run(pgo_ + " " + path);
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("bad.g2o:5: information matrix of edge 1 -> 2 is not positive definite"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(PgoProgram, EmptyFileGetsAClearError) {
+  const std::string path = (dir_ / "empty.g2o").string();
+  std::ofstream(path) << "";
+  const ProgramRun r = run(pgo_ + " " + path);
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("no vertices and no edges"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("singular"), std::string::npos) << r.out;
+}
+
+TEST_F(PgoProgram, DisconnectedGraphIsSolvedPerComponent) {
+  // Before: marginals of 4.7e28 m^2, unflagged.
+  PoseGraph a = testing::make_walk_graph(40, 3, 0.05);
+  PoseGraph g = a;
+  const int n = static_cast<int>(a.poses.size());
+  for (int k = 0; k < n; ++k) g.add_vertex(500 + k, a.poses[k] * Pose2(0, 30, 0));
+  for (Edge e : a.edges) {
+    e.from += n;
+    e.to += n;
+    g.edges.push_back(e);
+  }
+  const std::string path = (dir_ / "two.g2o").string(), csv = (dir_ / "two.csv").string();
+  ASSERT_TRUE(write_g2o(g, path));
+  const ProgramRun r = run(pgo_ + " " + path + " --marginals " + csv);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string json = last_line(r.out);
+  EXPECT_EQ(json_value(json, "components"), "2") << json;
+  EXPECT_EQ(json_value(json, "converged"), "true") << json;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  int rows = 0, second = 0;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string id, component, x, y, theta, cxx;
+    std::getline(ss, id, ',');
+    std::getline(ss, component, ',');
+    std::getline(ss, x, ',');
+    std::getline(ss, y, ',');
+    std::getline(ss, theta, ',');
+    std::getline(ss, cxx, ',');
+    EXPECT_LT(std::stod(cxx), 1.0) << line;  // m^2: relative to the component's fixed vertex
+    second += component == "1";
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2 * n);
+  EXPECT_EQ(second, n);
+}
+
+TEST_F(PgoProgram, ReadsEdgeOnlyFiles) {
+  // The SE-Sync graphs (city10000) have no VERTEX lines: the first 2,000 edges of it.
+  const std::string path = (dir_ / "city-edges.g2o").string();
+  ASSERT_EQ(
+      run("grep -m 2000 '^EDGE_SE2' ../shared/data/posegraphs/city10000.g2o > " + path).exit_code,
+      0);
+  const ProgramRun r = run(pgo_ + " " + path + " --no-marginals");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string json = last_line(r.out);
+  EXPECT_EQ(json_value(json, "initialised_from_edges"), "true") << json;
+  EXPECT_EQ(json_value(json, "converged"), "true") << json;
+  EXPECT_EQ(json_value(json, "components"), "1") << json;
+  // The spanning tree starts from the odometry chain's own composition: chi2 only falls.
+  EXPECT_LE(std::stod(json_value(json, "final_chi2")), std::stod(json_value(json, "initial_chi2")));
 }
 
 TEST_F(PgoProgram, UnknownConfigKeyIsAnError) {

@@ -1,5 +1,7 @@
 #include "process_tracker.hpp"
 
+#include "report.hpp"
+
 #include <gtest/gtest.h>
 
 namespace traverse::validate {
@@ -50,6 +52,44 @@ TEST(ProcessTracker, AProcessThatSaidStoppingIsStoppedNotSilent) {
   const auto s = t.summary(100 * kSecond).at("a");
   EXPECT_EQ(s.state, "stopped");
   EXPECT_EQ(s.last.state, "stopping");
+}
+
+TEST(ProcessTracker, AProcessThatSaidStoppedLongAgoIsNotSilent) {
+  // A process's last status after its shutdown work (an export) says "stopped"; the monitor's
+  // summary comes seconds later. Before: "silent for 3.2 s", and a clean run was not ok.
+  ProcessTracker t(3.0);
+  t.add("STATUS_MAPPER", 0, report("mapper", 0));
+  t.add("STATUS_MAPPER", kSecond, report("mapper", 1, "stopping"));
+  t.add("STATUS_MAPPER", 6 * kSecond, report("mapper", 2, "stopped"));
+  const auto s = t.summary(10 * kSecond).at("mapper");
+  EXPECT_EQ(s.state, "stopped");
+  EXPECT_TRUE(process_problems(t.summary(10 * kSecond)).empty());
+}
+
+TEST(ProcessTracker, LossesBeyondTheThresholdsAreProblems) {
+  ProcessTracker t(3.0);
+  ProcessReport r = report("frontend", 0);
+  t.add("STATUS_FRONTEND", 0, r);
+  r = report("frontend", 1);
+  r.missed = 238;
+  r.queue_dropped = 2;
+  r.rejected = 1;
+  t.add("STATUS_FRONTEND", 6 * kSecond, r);  // 6 s without a status: stopped or hung
+  const auto problems = process_problems(t.summary(6 * kSecond));
+  ASSERT_EQ(problems.size(), 4u);
+  EXPECT_NE(problems[0].find("no status for 6.0 s"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("238 messages missed"), std::string::npos) << problems[1];
+  EXPECT_NE(problems[2].find("2 messages dropped by its receive queue"), std::string::npos);
+  EXPECT_NE(problems[3].find("1 messages rejected"), std::string::npos);
+  Thresholds lenient;
+  lenient.max_status_gap_s = 10.0;
+  lenient.max_missed = 500;
+  lenient.max_queue_dropped = 5;
+  lenient.max_rejected = 1;
+  EXPECT_TRUE(process_problems(t.summary(6 * kSecond), lenient).empty());
+  lenient.timing = false;  // a replay: statuses carry no timing
+  lenient.max_status_gap_s = 1.0;
+  EXPECT_TRUE(process_problems(t.summary(6 * kSecond), lenient).empty());
 }
 
 TEST(ProcessTracker, ANewPidIsARestartNotASequenceGap) {
