@@ -281,6 +281,16 @@ std::optional<BackendUpdate> Backend::optimise() {
   return update;
 }
 
+std::string Backend::input_fault() const {
+  const long poses = counters_.prep.poses, dropped = counters_.prep.out_of_order;
+  if (poses < 2) return {};
+  const std::size_t keys = key_poses_.size();
+  if (keys >= 2 && 2 * dropped <= poses) return {};
+  return std::to_string(dropped) + " of " + std::to_string(poses) +
+         " frontend poses were not later than the pose before (stamps that carry no time?), " +
+         std::to_string(keys) + " key pose" + (keys == 1 ? "" : "s") + ": no trajectory";
+}
+
 std::optional<BackendUpdate> Backend::finish() {
   std::optional<BackendUpdate> last;
   if (const std::optional<PreparedPose> pose = prep_.finish()) last = take_pose(*pose);

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "correlative_matcher.hpp"
@@ -189,6 +190,10 @@ class Backend {
   const std::vector<LoopClosure>& closures() const { return closures_; }
   const LoopCloserCounters& loop_counters() const { return loop_.counters(); }
   const BackendCounters& counters() const { return counters_; }
+  // Why the frontend's poses gave no trajectory, in words; empty when they did. Stamps that carry
+  // no time (all equal, or mostly not later than the pose before) leave one key pose of many
+  // poses: that is a failure to report, not a one-pose result.
+  std::string input_fault() const;
   int analyses() const { return spa_.system().analyses(); }
   int orderings_reused() const { return spa_.system().orderings_reused(); }
 

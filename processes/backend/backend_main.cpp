@@ -23,6 +23,11 @@ int main(int argc, char** argv) {
   const int rc = proc.spin([&node] { node.report_counters(); });
   node.finish();
   node.report_counters();
+  if (const std::string fault = node.backend().input_fault(); !fault.empty()) {
+    std::cerr << "traverse-backend: " << fault << "\n";
+    proc.publish_status("failed: " + fault);
+    return rc != 0 ? rc : traverse::backend::kNoTrajectoryExitCode;
+  }
   proc.publish_status("stopped");
   return rc;
 }

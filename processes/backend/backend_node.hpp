@@ -44,6 +44,9 @@ struct BackendNodeConfig {
 // An error message when a value is out of range, empty when the config is valid.
 std::string validate(const BackendNodeConfig& config);
 
+// traverse-backend's exit code when its input gave no trajectory (Backend::input_fault()).
+inline constexpr int kNoTrajectoryExitCode = 3;
+
 class BackendNode {
  public:
   using CounterSink = std::function<void(const std::string& name, double value)>;

@@ -132,6 +132,40 @@ TEST(Backend, OddStampsAreDroppedAndCountedWithoutACrash) {
   for (const KeyPose& k : keys) EXPECT_LT(k.T_world_base.translation().norm(), 10.0);
 }
 
+// Stamps restamped from a log without time, one microsecond apart: a key pose by time would
+// never come (before: one key pose of 80); by travel and turn they come as the platform moves.
+// Stamps all equal: every pose after the first is out of order, and the backend says there is no
+// trajectory instead of publishing a single key pose as a result.
+TEST(Backend, StampsThatCarryNoTimeGiveKeyPosesByTravelOrAFault) {
+  const test::Drive d = test::drive_ellipse(8.0);
+  for (const int64_t spacing_us : {int64_t{1}, int64_t{0}}) {
+    BackendConfig config;
+    config.key_poses.distance_m = 0.5;
+    config.key_poses.angle_rad = 0.35;
+    Backend backend(config);
+    for (std::size_t k = 0; k < d.utimes.size(); ++k) {
+      const int64_t utime = 1'000'000 + static_cast<int64_t>(k) * spacing_us;
+      PlanarScan scan = d.scans[k];
+      scan.utime_first = scan.utime_last = utime;
+      backend.add_scan(scan);
+      backend.add_pose(utime, d.input[k]);
+    }
+    backend.finish();
+    const auto& keys = backend.key_poses();
+    if (spacing_us > 0) {
+      EXPECT_EQ(backend.input_fault(), "");
+      EXPECT_GT(keys.size(), 5u);
+      EXPECT_EQ(backend.counters().optimisations_failed, 0);
+      for (const KeyPose& k : keys) EXPECT_LT(k.T_world_base.translation().norm(), 10.0);
+    } else {
+      EXPECT_LE(keys.size(), 1u);
+      EXPECT_EQ(backend.counters().prep.out_of_order, static_cast<long>(d.utimes.size()) - 1);
+      EXPECT_NE(backend.input_fault().find("no trajectory"), std::string::npos)
+          << backend.input_fault();
+    }
+  }
+}
+
 TEST(Backend, ConfigValidation) {
   BackendConfig config;
   EXPECT_EQ(validate(config), "");
