@@ -197,18 +197,26 @@ TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
   // after the first and 0.18 s before the last, 6 cm off the path interpolated by time, which is
   // shorter; its neighbours lie 3.83 s apart, so nothing is known of the path between them, and
   // it is kept.
-  const auto turn = [](const DensifierConfig& config) {
+  const auto turn = [](const DensifierConfig& config, int64_t t1, int64_t t2) {
     Densifier g(config);
     std::vector<Segment> out;
     g.add_dense(kT0, Pose2(17.0311, -0.6614, 1.8256), &out);
-    g.add_dense(kT0 + 3'650'000, Pose2(17.0485, -0.6493, 1.6204), &out);
-    g.add_dense(kT0 + 3'830'000, Pose2(16.9879, -0.6737, 2.1498), &out);
+    g.add_dense(kT0 + t1, Pose2(17.0485, -0.6493, 1.6204), &out);
+    g.add_dense(kT0 + t2, Pose2(16.9879, -0.6737, 2.1498), &out);
     return g.spikes_replaced();
   };
-  EXPECT_EQ(turn(DensifierConfig{}), 0);
+  EXPECT_EQ(turn(DensifierConfig{}, 3'650'000, 3'830'000), 0);
   DensifierConfig any_span;
   any_span.spike_max_span_us = 4'000'000;
-  EXPECT_EQ(turn(any_span), 1);  // what the check did before it looked at the span
+  // what the check did before it looked at the span
+  EXPECT_EQ(turn(any_span, 3'650'000, 3'830'000), 1);
+  // The same poses with neighbours 0.5 s apart, as in a 4 Hz log (CARMEN freiburg-079): no
+  // scanner's stream either (a span of 0.5 s replaced real turns there), but 0.2 s apart they are.
+  EXPECT_EQ(turn(DensifierConfig{}, 476'500, 500'000), 0);
+  DensifierConfig half_second = any_span;
+  half_second.spike_max_span_us = 500'000;
+  EXPECT_EQ(turn(half_second, 476'500, 500'000), 1);
+  EXPECT_EQ(turn(DensifierConfig{}, 190'600, 200'000), 1);
 }
 
 }  // namespace
