@@ -29,6 +29,7 @@ std::string validate(const BackendConfig& c) {
   if (auto e = validate(c.link); !e.empty()) return "link." + e;
   if (auto e = validate(c.link_refine); !e.empty()) return "link_refine." + e;
   if (auto e = validate(c.loop); !e.empty()) return "loop." + e;
+  if (auto e = validate(c.odometry); !e.empty()) return "odometry." + e;
   if (auto e = validate(c.spa); !e.empty()) return "spa." + e;
   if (c.closure_max_chi2_increase < 0.0) return "closure_max_chi2_increase must be >= 0";
   if (c.link_chain_length < 1) return "link_chain_length must be >= 1";
@@ -57,6 +58,7 @@ Backend::Backend(BackendConfig config)
       link_matcher_(config_.link),
       link_refiner_(config_.link_refine),
       loop_(config_.loop),
+      odometry_(config_.odometry),
       spa_(config_.spa),
       trial_spa_(config_.spa),
       prep_(config_.smoothing) {}
@@ -112,7 +114,7 @@ std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
   return std::nullopt;
 }
 
-void Backend::add_frontend_edges(int key) {
+std::pair<Eigen::Matrix3d, Eigen::Matrix3d> Backend::frontend_covariances() const {
   const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
   const Eigen::Matrix3d fixed = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
   const double scale = config_.frontend_covariance ? config_.frontend_covariance_scale : 0.0;
@@ -121,19 +123,36 @@ void Backend::add_frontend_edges(int key) {
   };
   const PreparedPose& a = last_key_;
   const PreparedPose& b = since_key_.back();
-  Eigen::Matrix3d ca = covariance(a);
   const Eigen::Matrix3d cb = covariance(b);
   // The frontend's first pose defines its map and carries no covariance: it takes its
   // neighbour's.
-  if (scale > 0.0 && a.frontend.covariance.isZero()) ca = cb;
-  if (!drift_model_) {
-    graph_.edges.push_back(motion_edge(key_vertex(key - 1), key_vertex(key), a, b, ca, cb));
+  if (scale > 0.0 && a.frontend.covariance.isZero()) return {cb, cb};
+  return {covariance(a), cb};
+}
+
+void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odometry) {
+  const PreparedPose& a = last_key_;
+  const PreparedPose& b = since_key_.back();
+  const auto [ca, cb] = frontend_covariances();
+  const int from = drift_model_ ? key_vertex(key - 1) + 1 : key_vertex(key - 1);
+  const int to = drift_model_ ? key_vertex(key) + 1 : key_vertex(key);
+  if (odometry) {  // the odometry's step instead of the frontend's
+    Edge edge;
+    edge.from = from;
+    edge.to = to;
+    edge.T_from_to = odometry->motion;
+    edge.information = odometry->covariance.inverse();
+    graph_.edges.push_back(edge);
+    edge_kinds_.push_back(drift_model_ ? EdgeKind::kFrontendDrift : EdgeKind::kFrontend);
+  } else if (!drift_model_) {
+    graph_.edges.push_back(motion_edge(from, to, a, b, ca, cb));
     edge_kinds_.push_back(EdgeKind::kFrontend);
-    return;
+  } else {
+    graph_.edges.push_back(drift_edge(from, to, a, b, ca, cb, config_.frontend_drift_length_m));
+    edge_kinds_.push_back(EdgeKind::kFrontendDrift);
   }
-  const int m_a = key_vertex(key - 1) + 1, m_b = key_vertex(key) + 1;
-  graph_.edges.push_back(drift_edge(m_a, m_b, a, b, ca, cb, config_.frontend_drift_length_m));
-  edge_kinds_.push_back(EdgeKind::kFrontendDrift);
+  if (!drift_model_) return;
+  const int m_b = to;
   Edge pose;
   pose.from = m_b;
   pose.to = key_vertex(key);
@@ -173,7 +192,18 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     // Link to the previous key pose: match against the last few key scans around the frontend's
     // relative motion.
     const int prev = index - 1;
-    const Pose2 motion = between(last_key_.T_world_base, now.T_world_base);
+    Pose2 motion = between(last_key_.T_world_base, now.T_world_base);
+    // A frontend step the odometry contradicts is replaced by the odometry's.
+    std::optional<OdometryStep> odometry;
+    if (frontend) {
+      const auto [ca, cb] = frontend_covariances();
+      odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
+      if (odometry && odometry->frontend_rejected) {
+        motion = odometry->motion;
+      } else {
+        odometry.reset();
+      }
+    }
     const Pose2 T_world_guess = key_poses_[prev].T_world_base * motion;
     std::vector<Eigen::Vector2d> reference;
     for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
@@ -217,7 +247,7 @@ void Backend::add_key_pose(const PlanarScan& scan) {
       graph_.edges.push_back(link);
       edge_kinds_.push_back(EdgeKind::kLink);
     }
-    if (frontend) add_frontend_edges(index);
+    if (frontend) add_frontend_edges(index, odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
   }
   scans_.add(std::move(points));

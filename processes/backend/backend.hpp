@@ -25,6 +25,7 @@
 
 #include "correlative_matcher.hpp"
 #include "loop_closer.hpp"
+#include "odometry_check.hpp"
 #include "pose_graph.hpp"
 #include "scan_store.hpp"
 #include "spa.hpp"
@@ -78,6 +79,8 @@ struct BackendConfig {
   bool frontend_covariance = true;
   double frontend_covariance_scale = 1.0;  // [unitless]
   double frontend_drift_length_m = 0.0;    // [m]
+  // Wheel odometry, when there is any, as a check on each frontend step (odometry_check.hpp).
+  OdometryCheckConfig odometry;
   LoopCloserConfig loop;
   // A closure is added to a copy of the graph and both are optimised: if the graph's chi2 grows
   // by more than this, the closure contradicts the graph and is left out (0: not checked). For a
@@ -106,6 +109,7 @@ struct BackendConfig {
     v("frontend_covariance", frontend_covariance);
     v("frontend_covariance_scale", frontend_covariance_scale);
     v("frontend_drift_length_m", frontend_drift_length_m);
+    v("odometry", odometry);
     v("loop", loop);
     v("closure_max_chi2_increase", closure_max_chi2_increase);
     v("spa", spa);
@@ -165,6 +169,9 @@ class Backend {
 
   // A scan of the horizontal scanner (before its frontend pose arrives).
   void add_scan(PlanarScan scan);
+  // A wheel odometry reading: the base in the drifting odom frame (before the frontend poses of
+  // its time arrive).
+  void add_odometry(int64_t utime, const Pose2& T_odom_base) { odometry_.add(utime, T_odom_base); }
   // The frontend pose of the scan ending at `utime`; returns an update when the graph was
   // optimised. Each pose is taken in when the next one arrives (or at finish()): only then can it
   // be told apart from an outlier.
@@ -189,6 +196,7 @@ class Backend {
   const ScanStore& scans() const { return scans_; }
   const std::vector<LoopClosure>& closures() const { return closures_; }
   const LoopCloserCounters& loop_counters() const { return loop_.counters(); }
+  const OdometryCounters& odometry_counters() const { return odometry_.counters(); }
   const BackendCounters& counters() const { return counters_; }
   // Why the frontend's poses gave no trajectory, in words; empty when they did. Stamps that carry
   // no time (all equal, or mostly not later than the pose before) leave one key pose of many
@@ -201,8 +209,12 @@ class Backend {
   std::optional<BackendUpdate> take_pose(const PreparedPose& pose);
   // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
-  // Adds the frontend's edges of the new key pose `key` (frontend_chain.hpp).
-  void add_frontend_edges(int key);
+  // The frontend's covariances of the last key pose and the newest prepared pose, each in its own
+  // frame (frontend_chain.hpp).
+  std::pair<Eigen::Matrix3d, Eigen::Matrix3d> frontend_covariances() const;
+  // Adds the frontend's edges of the new key pose `key` (frontend_chain.hpp); `odometry`: the
+  // odometry's step when it rejected the frontend's, which then takes its place.
+  void add_frontend_edges(int key, const std::optional<OdometryStep>& odometry);
   // Adds the closure unless a trial optimisation finds it inconsistent with the graph.
   void add_closure(LoopClosure closure);
   std::optional<BackendUpdate> optimise();
@@ -213,6 +225,7 @@ class Backend {
   CorrelativeMatcher link_matcher_;
   ScanRefiner link_refiner_;
   LoopCloser loop_;
+  OdometryCheck odometry_;
   SpaOptimizer spa_;
   SpaOptimizer trial_spa_;  // for the graph with a closure on trial
   BackendCounters counters_;

@@ -31,6 +31,15 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
   bus_.subscribe<planar_scan_t>(config_.scan_channel,
                                 [this](const planar_scan_t& m) { on_scan(m); });
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
+  if (!config_.odometry_channel.empty()) {
+    bus_.subscribe<odometry_t>(config_.odometry_channel,
+                               [this](const odometry_t& m) { on_odometry(m); });
+  }
+}
+
+void BackendNode::on_odometry(const odometry_t& msg) {
+  if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
+  backend_.add_odometry(msg.utime, Pose2(msg.x, msg.y, msg.theta));
 }
 
 void BackendNode::on_scan(const planar_scan_t& msg) { backend_.add_scan(to_planar_scan(msg)); }
@@ -156,6 +165,11 @@ void BackendNode::report_counters() {
   counters_("links_matched", static_cast<double>(c.links_matched));
   counters_("links_fallback", static_cast<double>(c.links_fallback));
   counters_("links_refined", static_cast<double>(c.links_refined));
+  const OdometryCounters& o = backend_.odometry_counters();
+  counters_("odometry_readings", static_cast<double>(o.readings));
+  counters_("odometry_out_of_order", static_cast<double>(o.readings_out_of_order));
+  counters_("odometry_steps_checked", static_cast<double>(o.steps_checked));
+  counters_("frontend_steps_replaced_by_odometry", static_cast<double>(o.steps_replaced));
   counters_("loop_closures", static_cast<double>(backend_.closures().size()));
   counters_("loop_episodes", static_cast<double>(l.episodes));
   counters_("loop_candidates", static_cast<double>(l.candidates));

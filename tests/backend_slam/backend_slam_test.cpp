@@ -166,6 +166,65 @@ TEST(Backend, StampsThatCarryNoTimeGiveKeyPosesByTravelOrAFault) {
   }
 }
 
+// A frontend that loses track: from scan 30 on its poses are off by 1.2 m and 0.6 rad (a wrong
+// match it never undoes), with as small a covariance as before. Wheel odometry (here the truth
+// with a 2 % scale error) contradicts that one step; the backend takes the odometry's step
+// there, and the links match the scans around it. Without odometry the jump stays.
+TEST(Backend, OdometryReplacesAFrontendStepItContradicts) {
+  test::Drive d = test::drive_ellipse(8.0);
+  for (std::size_t k = 0; k < d.input.size(); ++k) {
+    d.input[k] = d.truth[k];
+    if (k >= 30) d.input[k] = Pose2(1.2, 0.0, 0.6) * d.truth[k];
+  }
+  const Eigen::Matrix3d covariance = Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal();
+  const auto run = [&](bool odometry) {
+    BackendConfig config;
+    config.smoothing.input = "sparse";  // no jump smoothing: the step reaches the graph
+    Backend backend(config);
+    for (std::size_t k = 0; k < d.utimes.size(); ++k) {
+      if (odometry) {
+        const Pose2& T = d.truth[k];
+        backend.add_odometry(d.utimes[k], Pose2(1.02 * T.x(), 1.02 * T.y(), T.theta()));
+      }
+      backend.add_scan(d.scans[k]);
+      backend.add_pose(d.utimes[k], d.input[k], covariance);
+    }
+    backend.finish();
+    // The last key pose against the truth, in the frame of the first (fixed at the truth).
+    const KeyPose& last = backend.key_poses().back();
+    const std::size_t k = static_cast<std::size_t>(
+        std::find(d.utimes.begin(), d.utimes.end(), last.utime) - d.utimes.begin());
+    EXPECT_LT(k, d.utimes.size());
+    return std::pair{(last.T_world_base.translation() - d.truth[k].translation()).norm(),
+                     backend.odometry_counters().steps_replaced};
+  };
+  const auto [error_without, replaced_without] = run(false);
+  const auto [error_with, replaced_with] = run(true);
+  EXPECT_EQ(replaced_without, 0);
+  EXPECT_EQ(replaced_with, 1);
+  EXPECT_GT(error_without, 0.5);  // [m]
+  EXPECT_LT(error_with, 0.05);    // [m]
+}
+
+TEST(OdometryCheck, InterpolatesBetweenReadingsAndKnowsItsGaps) {
+  OdometryCheck check{OdometryCheckConfig{}};
+  check.add(1'000'000, Pose2(0.0, 0.0, 0.0));
+  check.add(1'100'000, Pose2(0.1, 0.0, 0.0));
+  check.add(1'100'000, Pose2(9.0, 0.0, 0.0));  // not later: dropped
+  check.add(3'000'000, Pose2(0.2, 0.0, 0.0));  // 1.9 s later: nothing known between
+  EXPECT_EQ(check.counters().readings_out_of_order, 1);
+  const Eigen::Matrix3d none = Eigen::Matrix3d::Zero();
+  const auto step = check.check(1'000'000, 1'050'000, Pose2(0.05, 0.0, 0.0), none);
+  ASSERT_TRUE(step);
+  EXPECT_NEAR(step->motion.x(), 0.05, 1e-9);
+  EXPECT_FALSE(step->frontend_rejected);
+  const auto jump = check.check(1'000'000, 1'050'000, Pose2(0.55, 0.0, 0.0), none);
+  ASSERT_TRUE(jump);
+  EXPECT_TRUE(jump->frontend_rejected);
+  EXPECT_FALSE(check.check(1'000'000, 2'000'000, Pose2(), none));  // inside the gap
+  EXPECT_FALSE(check.check(0, 1'000'000, Pose2(), none));          // 1 s before the first reading
+}
+
 TEST(Backend, ConfigValidation) {
   BackendConfig config;
   EXPECT_EQ(validate(config), "");
