@@ -43,6 +43,9 @@ std::string validate(const JumpSmoothingConfig& c) {
     return "input must be auto, stream or sparse";
   }
   if (c.sparse_interval_us < 1) return "sparse_interval_us must be >= 1";
+  if (c.min_stream_interval_us < 0 || c.min_stream_interval_us >= c.sparse_interval_us) {
+    return "min_stream_interval_us must be >= 0 and below sparse_interval_us";
+  }
   return {};
 }
 

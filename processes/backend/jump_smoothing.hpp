@@ -44,6 +44,10 @@ struct JumpSmoothingConfig {
   // [us] a median interval above this is a log subsampled by travel: the frontend's rule
   // (configs/frontend.yaml, matcher.wide_search_gap_us).
   int64_t sparse_interval_us = 500000;
+  // [us] a median interval below this is no scanner's either (none sweeps at 200 Hz): stamps
+  // squeezed together (a log restamped a microsecond or a millisecond apart after its clock
+  // failed), whose times say nothing of the motion; taken like a log subsampled by travel.
+  int64_t min_stream_interval_us = 5000;
 
   template <class V>
   void visit(V& v) {
@@ -57,6 +61,7 @@ struct JumpSmoothingConfig {
     v("min_jump_rad", min_jump_rad);
     v("input", input);
     v("sparse_interval_us", sparse_interval_us);
+    v("min_stream_interval_us", min_stream_interval_us);
   }
 };
 

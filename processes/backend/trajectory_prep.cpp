@@ -17,9 +17,11 @@ bool TrajectoryPrep::sparse() const {
   if (config_.input == "stream") return false;
   if (config_.input == "sparse") return true;
   if (intervals_us_.size() < kRecentIntervals) return false;
-  std::vector<int64_t> sorted(intervals_us_.begin(), intervals_us_.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  return sorted[sorted.size() / 2] > config_.sparse_interval_us;
+  // A scanner's stream: every recent interval within [min_stream_interval_us,
+  // sparse_interval_us]. One longer (a log subsampled by travel) or shorter (stamps squeezed
+  // together where a log's clock failed) says the times do not pace the motion.
+  const auto [lo, hi] = std::minmax_element(intervals_us_.begin(), intervals_us_.end());
+  return *hi > config_.sparse_interval_us || *lo < config_.min_stream_interval_us;
 }
 
 std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {

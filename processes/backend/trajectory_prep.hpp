@@ -3,11 +3,14 @@
 //  1. Poses out of time order are dropped (counted): the backend's times must increase.
 //  2. The kind of input is told from the intervals between poses: a scanner's stream (tens of
 //     poses per second) or a log subsampled by travel (a scan kept every metre or half radian,
-//     seconds apart; the CARMEN sets), by the median of the last five intervals, as the frontend
-//     tells them apart. Each kind has its own jump handling: a scanner's stream gets seed 000's
-//     jump smoothing (jump_smoothing.hpp); on a log subsampled by travel, where real steps of
-//     0.5-1.8 m and 0.5 rad come seconds apart, a step says nothing about the next one, so the
-//     poses pass unchanged and the pose graph weighs each step by the frontend's covariance.
+//     seconds apart; the CARMEN sets), by the last five intervals: a stream has all of them
+//     within [min_stream_interval_us, sparse_interval_us], so stamps squeezed together where a
+//     log's clock failed do not pass for a fast scanner (stricter than the frontend's median, which
+//     took Kummerle's full-rate intel for a stream half the time). Each kind has its own jump
+//     handling: a scanner's stream gets seed 000's jump smoothing (jump_smoothing.hpp); on a log
+//     subsampled by travel, where real steps of 0.5-1.8 m and 0.5 rad come seconds apart, a step
+//     says nothing about the next one, so the poses pass unchanged and the pose graph weighs each
+//     step by the frontend's covariance.
 //  3. Key-pose selection: a pose becomes a key pose when enough time has passed since the last
 //     one (seed 000 uses three per second), or when the platform has moved or turned enough.
 // Poses are T_world_base (the prepared frame, which starts equal to the frontend's map frame),
