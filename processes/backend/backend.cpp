@@ -193,25 +193,35 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     // relative motion.
     const int prev = index - 1;
     Pose2 motion = between(last_key_.T_world_base, now.T_world_base);
-    // A frontend step the odometry contradicts is replaced by the odometry's.
-    std::optional<OdometryStep> odometry;
-    if (frontend) {
-      const auto [ca, cb] = frontend_covariances();
-      odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
-      if (odometry && odometry->frontend_rejected) {
-        motion = odometry->motion;
-      } else {
-        odometry.reset();
-      }
-    }
-    const Pose2 T_world_guess = key_poses_[prev].T_world_base * motion;
     std::vector<Eigen::Vector2d> reference;
     for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
       scans_.append_world(j, key_poses_[j].T_world_base, reference);
     }
     std::vector<Eigen::Vector2d> query(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) query[i] = points[i].cast<double>();
-    const MatchResult m = link_matcher_.match(reference, query, T_world_guess);
+    MatchResult m = link_matcher_.match(reference, query, key_poses_[prev].T_world_base * motion);
+    // A frontend step the odometry contradicts: the scans decide. The link is matched around the
+    // odometry's step too, and the odometry's step replaces the frontend's only if the scans
+    // agree with it better (an odometry that slips or a log's restarted odometry must not
+    // replace a good frontend step).
+    std::optional<OdometryStep> odometry;
+    if (frontend) {
+      const auto [ca, cb] = frontend_covariances();
+      odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
+      if (odometry && odometry->frontend_rejected) {
+        const MatchResult mo =
+            link_matcher_.match(reference, query, key_poses_[prev].T_world_base * odometry->motion);
+        if (mo.valid && (!m.valid || mo.raw_response > m.raw_response)) {
+          m = mo;
+          motion = odometry->motion;
+          ++counters_.frontend_steps_replaced;
+        } else {
+          odometry.reset();
+        }
+      } else {
+        odometry.reset();
+      }
+    }
     Edge link;
     link.from = key_vertex(prev);
     link.to = key_vertex(index);

@@ -149,12 +149,15 @@ struct BackendUpdate {
 };
 
 struct BackendCounters {
-  TrajectoryPrepCounters prep;              // frontend poses received, dropped, smoothed
-  long scans = 0;                           // scans received
-  long key_poses_without_scan = 0;          // key pose deferred: its scan was missing
-  long links_matched = 0;                   // consecutive links from correlative matching
-  long links_refined = 0;                   // ... of which refined point to line
-  long links_fallback = 0;                  // ... from the frontend's motion (response too low)
+  TrajectoryPrepCounters prep;      // frontend poses received, dropped, smoothed
+  long scans = 0;                   // scans received
+  long key_poses_without_scan = 0;  // key pose deferred: its scan was missing
+  long links_matched = 0;           // consecutive links from correlative matching
+  long links_refined = 0;           // ... of which refined point to line
+  long links_fallback = 0;          // ... from the frontend's motion (response too low)
+  // Frontend steps the odometry contradicted and the scans matched better at the odometry's
+  // (odometry_check.hpp): replaced by the odometry's.
+  long frontend_steps_replaced = 0;
   long closures_rejected_inconsistent = 0;  // closures the trial optimisation refused
   long optimisations = 0;
   long optimisations_failed = 0;      // not converged or covariance not recovered

@@ -72,7 +72,7 @@ std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utim
   const Eigen::Matrix3d S = step.covariance + frontend_covariance;
   step.frontend_chi2 = e.dot(S.ldlt().solve(e));
   step.frontend_rejected = !(step.frontend_chi2 <= config_.max_frontend_chi2);
-  if (step.frontend_rejected) ++counters_.steps_replaced;
+  if (step.frontend_rejected) ++counters_.steps_contradicted;
   return step;
 }
 

@@ -196,7 +196,7 @@ TEST(Backend, OdometryReplacesAFrontendStepItContradicts) {
         std::find(d.utimes.begin(), d.utimes.end(), last.utime) - d.utimes.begin());
     EXPECT_LT(k, d.utimes.size());
     return std::pair{(last.T_world_base.translation() - d.truth[k].translation()).norm(),
-                     backend.odometry_counters().steps_replaced};
+                     backend.counters().frontend_steps_replaced};
   };
   const auto [error_without, replaced_without] = run(false);
   const auto [error_with, replaced_with] = run(true);
