@@ -27,6 +27,11 @@ int main(int argc, char** argv) {
                   config.spike_max_span_us);
     return traverse::kConfigErrorExitCode;
   }
+  if (config.spike_min_interval_us < 0) {
+    spdlog::error("{}: spike_min_interval_us must be >= 0, not {}", proc.config_path(),
+                  config.spike_min_interval_us);
+    return traverse::kConfigErrorExitCode;
+  }
   // Below a few kilobytes a message holds only a handful of segments and bursts grow long again.
   if (config.max_message_bytes < 4096) {
     spdlog::error("{}: max_message_bytes must be at least 4096, not {}", proc.config_path(),

@@ -206,17 +206,38 @@ TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
     return g.spikes_replaced();
   };
   EXPECT_EQ(turn(DensifierConfig{}, 3'650'000, 3'830'000), 0);
+  // ... and with any span too, its intervals being uneven (3.65 s and 0.18 s).
   DensifierConfig any_span;
   any_span.spike_max_span_us = 4'000'000;
-  // what the check did before it looked at the span
-  EXPECT_EQ(turn(any_span, 3'650'000, 3'830'000), 1);
-  // The same poses with neighbours 0.5 s apart, as in a 4 Hz log (CARMEN freiburg-079): no
-  // scanner's stream either (a span of 0.5 s replaced real turns there), but 0.2 s apart they are.
-  EXPECT_EQ(turn(DensifierConfig{}, 476'500, 500'000), 0);
-  DensifierConfig half_second = any_span;
+  EXPECT_EQ(turn(any_span, 3'650'000, 3'830'000), 0);
+  // Neighbours 0.5 s apart, as in a 4 Hz log (CARMEN freiburg-079), are no scanner's stream
+  // either (a span of 0.5 s replaced real turns there); a pose 0.15 m off its neighbours' path at
+  // 10 Hz is a spike.
+  const auto lone = [](const DensifierConfig& config, int64_t period_us) {
+    Densifier g(config);
+    std::vector<Segment> out;
+    g.add_dense(kT0, Pose2(0.0, 0.0, 0.0), &out);
+    g.add_dense(kT0 + period_us, Pose2(0.05, 0.15, 0.0), &out);
+    g.add_dense(kT0 + 2 * period_us, Pose2(0.1, 0.0, 0.0), &out);
+    return g.spikes_replaced();
+  };
+  EXPECT_EQ(lone(DensifierConfig{}, 250'000), 0);
+  DensifierConfig half_second;
   half_second.spike_max_span_us = 500'000;
-  EXPECT_EQ(turn(half_second, 476'500, 500'000), 1);
-  EXPECT_EQ(turn(DensifierConfig{}, 190'600, 200'000), 1);
+  EXPECT_EQ(lone(half_second, 250'000), 1);
+  EXPECT_EQ(lone(DensifierConfig{}, 100'000), 1);
+  // A turn on the spot whose stamps are squeezed out of the order of the motion (Kummerle's
+  // full-rate intel: 155.9, 146.3, 159.8 degrees within 50 ms, the last two microseconds apart):
+  // a real pose, kept (so are poses between uneven intervals: a stream comes at a steady rate).
+  const auto squeezed = [](const DensifierConfig& config) {
+    Densifier g(config);
+    std::vector<Segment> out;
+    g.add_dense(kT0, Pose2(11.0073, 0.0, 155.9 * M_PI / 180), &out);
+    g.add_dense(kT0 + 50'000, Pose2(11.0400, 0.0, 146.3 * M_PI / 180), &out);
+    g.add_dense(kT0 + 50'003, Pose2(11.0129, 0.0, 159.8 * M_PI / 180), &out);
+    return g.spikes_replaced();
+  };
+  EXPECT_EQ(squeezed(DensifierConfig{}), 0);
 }
 
 }  // namespace
