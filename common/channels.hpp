@@ -8,13 +8,15 @@ namespace traverse::channels {
 inline const std::string kScanHorizontal = "SCAN_HORIZONTAL";  // planar_scan_t, horizontal scanner
 inline const std::string kScanProfile = "SCAN_PROFILE";        // planar_scan_t, tilted scanner
 inline const std::string kImu = "IMU";                         // imu_t
-inline const std::string kOdometry = "ODOMETRY";              // odometry_t, wheel encoders
+inline const std::string kOdometry = "ODOMETRY";               // odometry_t, wheel encoders
 inline const std::string kPoseGroundTruth = "POSE_GROUND_TRUTH";  // pose2d_t, simulator truth
-inline const std::string kPoseReference = "POSE_REFERENCE";    // pose2d_t, external reference
-inline const std::string kPoseFrontend = "POSE_FRONTEND";      // pose2d_t, one per scan
+inline const std::string kPoseGroundTruth3d =
+    "POSE_GROUND_TRUTH_3D";                                  // pose3d_t, the same in 6-DoF
+inline const std::string kPoseReference = "POSE_REFERENCE";  // pose2d_t, external reference
+inline const std::string kPoseFrontend = "POSE_FRONTEND";    // pose2d_t, one per scan
 inline const std::string kKeyPoses = "KEY_POSES";  // key_poses_t, backend key poses (incremental)
-inline const std::string kPoseBackend = "POSE_BACKEND";  // pose2d_t, each backend key pose once
-inline const std::string kPoseDense = "POSE_DENSE";  // pose2d_t, corrected dense trajectory
+inline const std::string kPoseBackend = "POSE_BACKEND";      // pose2d_t, each backend key pose once
+inline const std::string kPoseDense = "POSE_DENSE";          // pose2d_t, corrected dense trajectory
 inline const std::string kDenseSegments = "DENSE_SEGMENTS";  // dense_segments_t, new or moved
 
 // LCM's udpm provider sends one message here when an instance starts: not part of any run.

@@ -1,16 +1,21 @@
 #!/usr/bin/env bash
-# scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--speed S] [--offline] [--duration S]
-#                       [--deskew-off]
+# scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--profile P] [--speed S] [--offline]
+#                       [--duration S] [--deskew-off]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
-# traverse-sim (cached as out/cache/ROUTE-seedN.lcmlog, regenerated when the sim program, the
-# route or its world is newer), runs the named stages of the graph on it (scripts/run-graph.sh,
-# configs/deploy/pipeline.yaml), and evaluates the last stage's trajectory against the ground
-# truth with traverse-evaluator. With no stage the ground truth is evaluated against itself (a
-# smoke test: every error is zero). Outputs under out/eval/ROUTE-seedN-STAGES/ (run.lcmlog,
-# errors.csv, errors.png, evaluator.log); prints one JSON object as its last line.
+# traverse-sim, configs/sim.yaml and configs/rig.yaml (cached as
+# out/cache/ROUTE-seedN-PROFILE[-noprofiles]-HASH.lcmlog, HASH of the route, its world, sim.yaml
+# and rig.yaml; without the mapper among the stages the tilted scanner's profiles are left out;
+# regenerated when the sim program is newer), runs the named stages of the graph on it
+# (scripts/run-graph.sh, configs/deploy/pipeline.yaml), and evaluates the last stage's trajectory
+# against the ground truth with traverse-evaluator. With no stage the ground truth is evaluated
+# against itself (a smoke test: every error is zero). Outputs under
+# out/eval/ROUTE-seedN-PROFILE-STAGES/ (run.lcmlog, errors.csv, errors.png, evaluator.log);
+# prints one JSON object as its last line.
 #   --stages LIST  comma-separated stage names, e.g. frontend (default: none)
 #   --seed N       simulator seed (default 1)
+#   --profile P    realistic (default: 3D cart, clocks, calibration errors, people, per-beam
+#                  errors, the bare corridor; configs/sim.yaml 'effects:') or ideal (none of them)
 #   --speed S      replay speed through the graph, times real time (default 1)
 #   --duration S   simulate only the route's first S seconds (quick checks; cached and evaluated
 #                  under ROUTE-seedN-dS)
@@ -30,11 +35,12 @@ usage() {
   exit "${1:-2}"
 }
 
-route="" stages="" seed=1 speed=1 duration=""
+route="" stages="" seed=1 speed=1 duration="" profile=realistic
 while (($#)); do
   case "$1" in
     --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
     --seed) seed="${2:?--seed needs a number}"; shift 2 ;;
+    --profile) profile="${2:?--profile needs ideal or realistic}"; shift 2 ;;
     --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
     --offline) OFFLINE=1; shift ;;
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
@@ -47,6 +53,7 @@ done
 [[ -n $route ]] || usage
 [[ $route =~ ^[A-Za-z0-9._-]+$ && $route != .* ]] || die "route must be a name from configs/routes/, not '$route'"
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, not '$seed'"
+[[ $profile == ideal || $profile == realistic ]] || die "--profile must be ideal or realistic, not '$profile'"
 [[ -z $duration || $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--duration must be seconds, not '$duration'"
 
 route_file="$ROOT/configs/routes/$route.yaml"
@@ -62,15 +69,32 @@ esac
 
 need_programs traverse-sim traverse-evaluator
 
-# 1. The simulated log, cached by route and seed.
-run_name="$route-seed$seed${duration:+-d$duration}"
-cache="$ROOT/out/cache/$run_name.lcmlog"
+# 1. The simulated log, cached by route, seed, profile and the contents of every file it is made
+# from (the route, its world, configs/sim.yaml and the rig file it names, configs/rig.yaml).
+sim_config="$ROOT/configs/sim.yaml"
+rig_config="$ROOT/configs/rig.yaml"
+[[ -f $sim_config && -f $rig_config ]] || die "configs/sim.yaml or configs/rig.yaml missing"
+inputs_hash="$(cat "$route_file" "$world_file" "$sim_config" "$rig_config" | sha1sum | cut -c 1-10)"
+run_name="$route-seed$seed${duration:+-d$duration}-$profile"
+# Only the mapper reads the tilted profile scanner: without it the log leaves profiles out (a
+# third less to simulate and store). Every other stream is drawn from its own generator, so the
+# scans, IMU and ground truth are the same either way.
+profile_every=()
+if ! runs_mapper "$stages"; then
+  profile_every=(--profile-every 1000000000)
+  run_name="$run_name-noprofiles"
+fi
+cache="$ROOT/out/cache/$run_name-$inputs_hash.lcmlog"
 mkdir -p "$ROOT/out/cache"
-if stale "$cache" "$BIN/traverse-sim" "$route_file" "$world_file"; then
-  echo "eval-route: simulating $route (seed $seed) -> $cache" >&2
+if stale "$cache" "$BIN/traverse-sim"; then
+  # Logs of the same run made from other inputs are of no more use (they are large).
+  rm -f "$ROOT/out/cache/$run_name"-??????????.lcmlog
+  echo "eval-route: simulating $route (seed $seed, $profile) -> $cache" >&2
   sim_start_ns=$(date +%s%N)
-  "$BIN/traverse-sim" --world "$world_file" --route "$route_file" --seed "$seed" \
-    ${duration:+--duration "$duration"} --out "$cache.tmp" >&2 || die "traverse-sim failed"
+  # From the repo root: configs/sim.yaml names the rig file relative to it.
+  (cd "$ROOT" && "$BIN/traverse-sim" --config configs/sim.yaml --world "$world_file" \
+    --route "$route_file" --seed "$seed" --profile "$profile" "${profile_every[@]}" \
+    ${duration:+--duration "$duration"} --out "$cache.tmp" >&2) || die "traverse-sim failed"
   mv "$cache.tmp" "$cache"
   echo "eval-route: simulated in $((($(date +%s%N) - sim_start_ns) / 1000000)) ms" >&2
 fi
@@ -82,5 +106,5 @@ if runs_mapper "$stages"; then
   need_programs traverse-cloud-eval
   cloud_evaluate "$world_file" "$out"
 fi
-echo "eval-route: $route seed $seed stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"deskew_off\": $([[ -n $DESKEW_OFF ]] && echo true || echo false), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+echo "eval-route: $route seed $seed ($profile) stages ${stages:-none}: outputs in $out" >&2
+merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"profile\": $(json_str "$profile"), \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"deskew_off\": $([[ -n $DESKEW_OFF ]] && echo true || echo false), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,7 @@ struct BackendNodeConfig {
 };
 
 // An error message when a value is out of range, empty when the config is valid.
-std::string validate(const BackendNodeConfig& config);
+std::optional<std::string> validate(const BackendNodeConfig& config);
 
 // traverse-backend's exit code when its input gave no trajectory (Backend::input_fault()).
 inline constexpr int kNoTrajectoryExitCode = 3;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <deque>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 namespace {
 
@@ -37,16 +39,23 @@ bool is_jump(const Eigen::Vector3d& v, double dt, const Eigen::Vector3d& mean,
 
 }  // namespace
 
-std::string validate(const JumpSmoothingConfig& c) {
-  if (c.window < 1) return "window must be >= 1";
-  if (c.input != "auto" && c.input != "stream" && c.input != "sparse") {
-    return "input must be auto, stream or sparse";
-  }
-  if (c.sparse_interval_us < 1) return "sparse_interval_us must be >= 1";
-  if (c.min_stream_interval_us < 0 || c.min_stream_interval_us >= c.sparse_interval_us) {
-    return "min_stream_interval_us must be >= 0 and below sparse_interval_us";
-  }
-  return {};
+std::optional<std::string> validate(const JumpSmoothingConfig& c) {
+  ConfigCheck check;
+  check.in_range("window", c.window, 1, 1000);
+  check.positive("speed_ratio", c.speed_ratio);
+  check.not_negative("min_jump_speed_mps", c.min_jump_speed_mps);
+  check.positive("max_direction_change_rad", c.max_direction_change_rad);
+  check.not_negative("min_moving_speed_mps", c.min_moving_speed_mps);
+  check.positive("max_turn_rate_radps", c.max_turn_rate_radps);
+  check.not_negative("min_jump_m", c.min_jump_m);
+  check.not_negative("min_jump_rad", c.min_jump_rad);
+  check.require(c.input == "auto" || c.input == "stream" || c.input == "sparse", "input",
+                "must be auto, stream or sparse");
+  check.positive("sparse_interval_us", c.sparse_interval_us);
+  check.not_negative("min_stream_interval_us", c.min_stream_interval_us);
+  check.require(c.min_stream_interval_us < c.sparse_interval_us, "min_stream_interval_us",
+                "must be below sparse_interval_us");
+  return check.problem();
 }
 
 SmoothedTrajectory smooth_jumps(std::vector<StampedPose> poses, const JumpSmoothingConfig& config) {

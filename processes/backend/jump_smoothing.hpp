@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,7 +67,8 @@ struct JumpSmoothingConfig {
 };
 
 // An error message when a value is out of range, empty when the config is valid.
-std::string validate(const JumpSmoothingConfig& config);
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const JumpSmoothingConfig& config);
 
 struct SmoothedTrajectory {
   std::vector<StampedPose> poses;

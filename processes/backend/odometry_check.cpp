@@ -4,20 +4,21 @@
 #include <algorithm>
 #include <cmath>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 
-std::string validate(const OdometryCheckConfig& c) {
-  if (!(c.min_sigma_xy_m > 0.0) || !(c.min_sigma_theta_rad > 0.0)) {
-    return "min_sigma_xy_m and min_sigma_theta_rad must be > 0";
-  }
-  if (c.sigma_xy_per_m < 0.0 || c.sigma_theta_per_m < 0.0 || c.sigma_theta_per_rad < 0.0) {
-    return "sigma_xy_per_m, sigma_theta_per_m and sigma_theta_per_rad must be >= 0";
-  }
-  if (!(c.max_frontend_chi2 > 0.0)) return "max_frontend_chi2 must be > 0";
-  if (c.max_reading_gap_us <= 0 || c.keep_us <= 0) {
-    return "max_reading_gap_us and keep_us must be > 0";
-  }
-  return {};
+std::optional<std::string> validate(const OdometryCheckConfig& c) {
+  ConfigCheck check;
+  check.positive("min_sigma_xy_m", c.min_sigma_xy_m);
+  check.not_negative("sigma_xy_per_m", c.sigma_xy_per_m);
+  check.positive("min_sigma_theta_rad", c.min_sigma_theta_rad);
+  check.not_negative("sigma_theta_per_m", c.sigma_theta_per_m);
+  check.not_negative("sigma_theta_per_rad", c.sigma_theta_per_rad);
+  check.positive("max_frontend_chi2", c.max_frontend_chi2);
+  check.positive("max_reading_gap_us", c.max_reading_gap_us);
+  check.positive("keep_us", c.keep_us);
+  return check.problem();
 }
 
 void OdometryCheck::add(int64_t utime, const Pose2& T_odom_base) {

@@ -55,7 +55,8 @@ struct OdometryCheckConfig {
   }
 };
 
-std::string validate(const OdometryCheckConfig& config);
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const OdometryCheckConfig& config);
 
 struct OdometryCounters {
   long readings = 0;               // odometry messages taken

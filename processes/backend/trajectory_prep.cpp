@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 namespace {
 
@@ -80,6 +82,14 @@ PreparedPose TrajectoryPrep::prepare(FrontendPose pose, const std::optional<Fron
             : 0.0;
   last_ = out;
   return out;
+}
+
+std::optional<std::string> validate(const KeyPoseConfig& c) {
+  ConfigCheck check;
+  check.positive("interval_us", c.interval_us);
+  check.not_negative("distance_m", c.distance_m);
+  check.not_negative("angle_rad", c.angle_rad);
+  return check.problem();
 }
 
 std::vector<int> select_key_poses(const std::vector<StampedPose>& poses,

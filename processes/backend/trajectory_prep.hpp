@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "jump_smoothing.hpp"
@@ -79,7 +80,7 @@ class TrajectoryPrep {
 };
 
 struct KeyPoseConfig {
-  int64_t interval_us = 333333;  // a key pose at least this often [us]; 0: not by time
+  int64_t interval_us = 333333;  // a key pose at least this often [us]
   double distance_m = 0.0;       // ... or after this travelled distance [m]; 0: not by distance
   double angle_rad = 0.0;        // ... or after this turned angle [rad]; 0: not by angle
 
@@ -90,6 +91,8 @@ struct KeyPoseConfig {
     v("angle_rad", angle_rad);
   }
 };
+
+std::optional<std::string> validate(const KeyPoseConfig& config);
 
 // Indices of the key poses: the first pose, then every pose at which one of the enabled criteria
 // is reached since the last key pose (distance and angle accumulated along the trajectory).

@@ -1,7 +1,8 @@
 // traverse-sim: simulated mobile laser scanner. Drives the cart along a route through a world and
-// publishes the horizontal scans, tilted profiles, IMU samples and ground-truth poses, either live
-// at the sensors' pace (times --speed) or as an LCM log (--out), which is byte-identical for the
-// same inputs and seed.
+// publishes the horizontal scans, tilted profiles, IMU samples and ground-truth poses (and, with
+// wheel encoders, odometry), either live at the sensors' pace (times --speed) or as an LCM log
+// (--out), which is byte-identical for the same inputs, profile and seed. --profile realistic
+// (the default) applies the effects of the config's `effects:`; --profile ideal none of them.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -32,6 +33,8 @@ const char* channel_of(traverse::sim::SimEvent::Kind kind) {
       return "imu";
     case K::kScanHorizontal:
       return "scans_horizontal";
+    case K::kOdometry:
+      return "odometry";
     default:
       return "scans_profile";
   }
@@ -48,7 +51,16 @@ int main(int argc, char** argv) {
   uint64_t seed = 0;
   double speed = 1.0;
   sim::RunOptions run;
+  std::string profile = "realistic";
+  bool wheel_encoders = false;
   auto& cli = proc.cli();
+  cli.add_option("--profile", profile,
+                 "realistic: the effects of the config's 'effects:' (3D cart, clocks, calibration, "
+                 "people, per-beam errors...); ideal: none of them")
+      ->check(CLI::IsMember({"ideal", "realistic"}))
+      ->capture_default_str();
+  cli.add_flag("--wheel-encoders", wheel_encoders,
+               "publish wheel odometry on ODOMETRY (as effects.wheel_encoders.enabled: true)");
   cli.add_option("--world", world_path, "world YAML (configs/worlds/)")->required();
   cli.add_option("--route", route_path, "route YAML (configs/routes/)")->required();
   cli.add_option("--seed", seed, "random seed (same inputs and seed give the same log)")
@@ -67,7 +79,11 @@ int main(int argc, char** argv) {
       ->excludes(out_opt);
 
   sim::SimConfig cfg;
+  // validate(cfg) included.
   if (auto rc = proc.start(argc, argv, cfg, !has_out_option(argc, argv))) return *rc;
+  if (wheel_encoders) cfg.effects.wheel_encoders.enabled = true;
+  const bool realistic = profile == "realistic";
+  const sim::Effects effects = realistic ? cfg.effects : cfg.effects.ideal();
 
   std::unique_ptr<sim::Simulator> simulator;
   try {
@@ -78,7 +94,7 @@ int main(int argc, char** argv) {
     sim::RouteSpec route;
     load_config(route_path, route);
     simulator = std::make_unique<sim::Simulator>(world, route, rig, cfg.platform, seed,
-                                                 cfg.start_utime, run);
+                                                 cfg.start_utime, run, effects);
   } catch (const ConfigError& e) {
     spdlog::error("traverse-sim: {}", e.what());
     return kConfigErrorExitCode;
@@ -118,7 +134,7 @@ int main(int argc, char** argv) {
       if (stop_requested()) break;
     }
     try {
-      sim::publish_event(publisher, *ev);
+      sim::publish_event(publisher, *ev, realistic);
     } catch (const std::exception& e) {
       spdlog::error("traverse-sim: {}", e.what());
       rc = 1;
@@ -144,6 +160,7 @@ int main(int argc, char** argv) {
                simulator->trajectory().duration_s());
   std::string json = "{";
   for (const auto& [k, v] : counts) json += "\"" + k + "\":" + std::to_string(v) + ",";
+  json += fmt::format("\"profile\":\"{}\",", profile);
   json += fmt::format(
       "\"sim_duration_s\":{:.3f},\"wall_s\":{:.3f},\"real_time_factor\":{:.3f},"
       "\"route_length_m\":{:.2f},\"route_duration_s\":{:.2f}}}",

@@ -16,8 +16,21 @@
 // - NovAtel SPAN UIMU-LCI (tactical grade, fibre-optic gyros) product sheet: gyro bias stability
 //   1.0 deg/h, angle random walk 0.05 deg/sqrt(h); accelerometer bias 1.0 mg. Its velocity random
 //   walk is not on the sheet; 0.05 m/s/sqrt(h), a usual tactical-grade figure, is used.
-// These figures were taken from the published sheets as remembered; check them against a copy of
-// the sheet before quoting results that depend on them.
+// - FARO Focus3D X 330 spec sheet: angular accuracy 19 arcsec (9.2e-5 rad) for both axes; used as
+//   the 1 sigma angle jitter of both FARO models.
+// - SICK LMS1xx operating instructions and SICK's note on LMS measurement errors: systematic error
+//   +-30 mm typical (+-40 mm maximum), statistical error 12 mm typical (20 mm maximum); beam
+//   diameter 8 mm at the cover growing by 15 mrad (distance x 0.015 rad + 8 mm); 25 or 50 Hz,
+//   0.25 or 0.5 deg over 270 deg, 20 m operating range, 18 m on 10 % reflectivity.
+// - Hokuyo UTM-30LX spec sheet: 40 Hz (25 ms per scan), 0.25 deg over 270 deg, 30 m (60 m
+//   maximum), accuracy +-30 mm to 10 m and +-50 mm to 30 m.
+// - SICK LMS200 (the scanner of the CARMEN/Kummerle logs) technical description: 75 Hz mirror,
+//   180 deg at 1 deg or 0.5 deg (two interlaced revolutions), 80 m (cm mode; 8191 cm reads as no
+//   return), 10 m on 10 % reflectivity; statistical error 5 mm (1 sigma), systematic +-15 mm (mm
+//   mode, 1-8 m); its beam is taken as the LMS1xx's (8 mm + 15 mrad), the sheet not giving it.
+// These figures were taken from the published sheets as remembered (the LMS1xx's from the
+// operating instructions); check them against a copy of the sheet before quoting results that
+// depend on them.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -67,8 +80,16 @@ struct RangeModel {
                                          // scales with sqrt(reflectivity * cos(incidence))
   double grazing_limit_rad = 1.396;      // [rad] (80 deg) beyond this incidence returns fade out
   double random_dropout = 0.0002;        // probability a beam returns nothing for no reason
+  // Used by the simulator's realistic beam effects only:
+  double angle_jitter_rad = 9.2e-5;  // [rad] 1 sigma of a beam's true angle about its nominal one
+  double dark_bias_m = 0.001;        // [m] range walk: a 10 % target reads this much longer than a
+                                     // 90 % one (linear in the returned level in between)
+  double range_resolution_m = 0.0;   // [m] ranges are output in steps of this (0: continuous)
   template <class V>
   void visit(V& v) {
+    v("angle_jitter_rad", angle_jitter_rad);
+    v("dark_bias_m", dark_bias_m);
+    v("range_resolution_m", range_resolution_m);
     v("noise_10m_bright_m", noise_10m_bright_m);
     v("noise_25m_bright_m", noise_25m_bright_m);
     v("noise_10m_dark_m", noise_10m_dark_m);
@@ -151,6 +172,42 @@ inline ScannerModel profile_focus3d() {
       "focus3d_120s_profile", 30.0, 8133, 2.0 * std::numbers::pi * 30.0 / 244000.0, 0.6, 6.0, {}};
 }
 
+// The common 2D lidars most users own, and the one of the CARMEN logs. Noise is flat in range
+// (datasheet_rate_pts_s equals the scanner's own rate, so no rate scaling).
+inline ScannerModel sick_class(std::string name, double rate_hz, int points, double step_deg,
+                               double range_max_m, double range_at_90_m, double noise_m,
+                               double noise_far_m, double ranging_error_m, double dark_bias_m,
+                               double resolution_m) {
+  RangeModel r;
+  r.noise_10m_bright_m = r.noise_10m_dark_m = noise_m;
+  r.noise_25m_bright_m = r.noise_25m_dark_m = noise_far_m;
+  const double step = step_deg * std::numbers::pi / 180.0;
+  r.datasheet_rate_pts_s = rate_hz * 2.0 * std::numbers::pi / step;
+  r.ranging_error_m = ranging_error_m;
+  r.beam_exit_diameter_m = 0.008;
+  r.beam_divergence_rad = 0.015;
+  r.range_at_90_percent_m = range_at_90_m;
+  r.angle_jitter_rad = 0.0;  // no figure on these sheets
+  r.dark_bias_m = dark_bias_m;
+  r.range_resolution_m = resolution_m;
+  return {std::move(name), rate_hz, points, step, 0.05, range_max_m, r};
+}
+// Systematic errors split evenly between a per-run offset and the range walk with darkness.
+inline ScannerModel sick_lms111() {
+  return sick_class("sick_lms111", 50.0, 541, 0.5, 20.0, 54.0, 0.012, 0.012, 0.015, 0.015, 0.001);
+}
+inline ScannerModel hokuyo_utm30lx() {
+  ScannerModel m =
+      sick_class("hokuyo_utm30lx", 40.0, 1081, 0.25, 30.0, 60.0, 0.015, 0.025, 0.015, 0.015, 0.001);
+  m.range.beam_exit_diameter_m = 0.01;  // not on the sheet: taken like the LMS1xx class,
+  m.range.beam_divergence_rad = 0.01;   // a little narrower
+  return m;
+}
+inline ScannerModel sick_lms200(int points, double step_deg) {
+  return sick_class(points > 200 ? "sick_lms200_half_deg" : "sick_lms200", 75.0, points, step_deg,
+                    81.0, 30.0, 0.005, 0.005, 0.0075, 0.0075, 0.01);
+}
+
 struct RigConfig {
   // Horizontal scanner about 50 cm above the floor (seed 000, section 3).
   Extrinsic laser_horizontal{0.0, 0.0, 0.5, 0.0, 0.0, 0.0};
@@ -158,7 +215,9 @@ struct RigConfig {
   // so its scan plane is tilted 10 deg from the vertical plane across the direction of travel.
   Extrinsic laser_profile{0.45, 0.0, 1.0, 0.0, 80.0 * std::numbers::pi / 180.0, 0.0};
   Extrinsic imu{-0.10, 0.05, 0.30, 0.0, 0.0, 0.0};
-  std::vector<ScannerModel> horizontal_scanners = {focus3d_120s(), focus3d_x330()};
+  std::vector<ScannerModel> horizontal_scanners = {focus3d_120s(),        focus3d_x330(),
+                                                   sick_lms111(),         hokuyo_utm30lx(),
+                                                   sick_lms200(181, 1.0), sick_lms200(361, 0.5)};
   ScannerModel profile_scanner = profile_focus3d();
   ImuModel imu_model;
   double ground_truth_rate_hz = 200.0;  // [Hz]

@@ -42,21 +42,40 @@ void Trajectory::add(Kind kind, const Pose2& start, double amount, double vmax, 
     wheel = kind == Kind::kLine ? amount : std::abs(amount) * platform_.half_track_m;
   }
   if (dur <= 0.0) return;
-  segments_.push_back({kind, t0, t0 + dur, start, amount, vmax, accel, dist_});
+  segments_.push_back({kind, t0, t0 + dur, start, amount, vmax, accel, dist_, -1});
   dist_ += wheel;
 }
 
-Trajectory::Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng)
+std::vector<Waypoint> expand_route(const RouteSpec& route, const std::vector<std::string>& layers) {
+  auto point = [](const std::vector<double>& p) {
+    if (p.size() != 2) throw std::runtime_error("route waypoint needs [x, y]");
+    return Eigen::Vector2d(p[0], p[1]);
+  };
+  std::vector<Waypoint> out;
+  for (std::size_t i = 0; i < route.waypoints.size(); ++i) {
+    const bool stop = std::find(route.stop_at.begin(), route.stop_at.end(), static_cast<int>(i)) !=
+                      route.stop_at.end();
+    out.push_back({point(route.waypoints[i]), stop});
+    for (const auto& d : route.detours) {
+      if (d.after < 0 || d.after + 1 >= static_cast<int>(route.waypoints.size()))
+        throw std::runtime_error("route detour 'after' must name a waypoint before the last");
+      if (d.after != static_cast<int>(i) ||
+          std::find(layers.begin(), layers.end(), d.layer) == layers.end())
+        continue;
+      for (const auto& p : d.waypoints) out.push_back({point(p), false});
+    }
+  }
+  return out;
+}
+
+Trajectory::Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng,
+                       const Effects& effects)
     : platform_(platform) {
   if (route.waypoints.size() < 2) throw std::runtime_error("route needs at least 2 waypoints");
   if (route.speed_mps <= 0.0 || platform.accel_mps2 <= 0.0 || platform.yaw_rate_radps <= 0.0 ||
       platform.yaw_accel_radps2 <= 0.0)
     throw std::runtime_error("route speed and platform rates must be > 0");
-  std::vector<Eigen::Vector2d> wp;
-  for (const auto& p : route.waypoints) {
-    if (p.size() != 2) throw std::runtime_error("route waypoint needs [x, y]");
-    wp.emplace_back(p[0], p[1]);
-  }
+  const std::vector<Waypoint> wp = expand_route(route, effects.world_layers);
   for (const auto& vib : platform.vibration) {
     if (vib.axis != "x" && vib.axis != "y" && vib.axis != "yaw")
       throw std::runtime_error("vibration axis must be x, y or yaw, not '" + vib.axis + "'");
@@ -64,29 +83,88 @@ Trajectory::Trajectory(const RouteSpec& route, const PlatformConfig& platform, R
     phases_.push_back(rng.uniform(0.0, 2.0 * std::numbers::pi));
     axes_.push_back(vib.axis == "x" ? 0 : vib.axis == "y" ? 1 : 2);
   }
-  auto heading_of = [&](std::size_t i) {
-    const Eigen::Vector2d d = wp[i + 1] - wp[i];
-    return std::atan2(d.y(), d.x());
-  };
-  double heading = route.start_heading_rad < 1e8 ? route.start_heading_rad : heading_of(0);
-  Pose2 pose(wp[0].x(), wp[0].y(), heading);
+  if (effects.motion.enabled)
+    plan_pushed(route, wp, effects.motion, rng);
+  else
+    plan_stop_and_turn(route, wp);
+  if (segments_.empty()) throw std::runtime_error("route has no motion");
+}
+
+namespace {
+
+// [rad] heading of the leg from waypoint i to i + 1.
+double leg_heading(const std::vector<Waypoint>& wp, std::size_t i) {
+  const Eigen::Vector2d d = wp[i + 1].p - wp[i].p;
+  return std::atan2(d.y(), d.x());
+}
+
+}  // namespace
+
+Pose2 Trajectory::start(const RouteSpec& route, const std::vector<Waypoint>& wp) {
+  const double heading =
+      route.start_heading_rad < 1e8 ? route.start_heading_rad : leg_heading(wp, 0);
+  const Pose2 pose(wp[0].p.x(), wp[0].p.y(), heading);
   add(Kind::kPause, pose, route.start_pause_s, 0, 0);
+  return pose;
+}
+
+void Trajectory::plan_stop_and_turn(const RouteSpec& route, const std::vector<Waypoint>& wp) {
+  auto heading_of = [&](std::size_t i) { return leg_heading(wp, i); };
+  Pose2 pose = start(route, wp);
+  double heading = pose.theta();
   for (std::size_t i = 0; i + 1 < wp.size(); ++i) {
     // Turn on the spot towards the next waypoint, then drive there.
     const double turn = wrap_angle(heading_of(i) - heading);
-    add(Kind::kTurn, pose, turn, platform.yaw_rate_radps, platform.yaw_accel_radps2);
+    add(Kind::kTurn, pose, turn, platform_.yaw_rate_radps, platform_.yaw_accel_radps2);
     heading = wrap_angle(heading + turn);
-    pose = Pose2(wp[i].x(), wp[i].y(), heading);
-    const double len = (wp[i + 1] - wp[i]).norm();
-    add(Kind::kLine, pose, len, route.speed_mps, platform.accel_mps2);
+    pose = Pose2(wp[i].p.x(), wp[i].p.y(), heading);
+    const double len = (wp[i + 1].p - wp[i].p).norm();
+    add(Kind::kLine, pose, len, route.speed_mps, platform_.accel_mps2);
     length_m_ += len;
-    pose = Pose2(wp[i + 1].x(), wp[i + 1].y(), heading);
-    if (std::find(route.stop_at.begin(), route.stop_at.end(), static_cast<int>(i + 1)) !=
-        route.stop_at.end())
-      add(Kind::kPause, pose, route.stop_s, 0, 0);
+    pose = Pose2(wp[i + 1].p.x(), wp[i + 1].p.y(), heading);
+    if (wp[i + 1].stop) add(Kind::kPause, pose, route.stop_s, 0, 0);
   }
   add(Kind::kPause, pose, route.end_pause_s, 0, 0);
-  if (segments_.empty()) throw std::runtime_error("route has no motion");
+}
+
+void Trajectory::add_run(PushedRun run, const Pose2& start) {
+  const double t0 = segments_.empty() ? 0.0 : segments_.back().t1;
+  segments_.push_back({Kind::kRun, t0, t0 + run.duration_s(), start, run.length_m(), 0, 0, dist_,
+                       static_cast<int>(runs_.size())});
+  dist_ += run.length_m();
+  length_m_ += run.length_m();
+  runs_.push_back(std::move(run));
+}
+
+void Trajectory::plan_pushed(const RouteSpec& route, const std::vector<Waypoint>& wp,
+                             const MotionEffect& motion, Rng& rng) {
+  // Runs between stops: a waypoint where the route pauses, or a reversal sharper than
+  // spin_turn_min_rad, ends a run; the cart then turns on the spot towards the next leg.
+  auto heading_of = [&](std::size_t i) { return leg_heading(wp, i); };
+  Pose2 pose = start(route, wp);
+  double heading = pose.theta();
+  std::size_t first = 0;
+  for (std::size_t i = 1; i < wp.size(); ++i) {
+    const bool last = i + 1 == wp.size();
+    const bool reversal = !last && std::abs(wrap_angle(heading_of(i) - heading_of(i - 1))) >=
+                                       motion.spin_turn_min_rad;
+    if (!last && !reversal && !wp[i].stop) continue;
+    // Turn on the spot towards the run's first leg, then roll through wp[first..i].
+    const double turn = wrap_angle(heading_of(first) - heading);
+    add(Kind::kTurn, pose, turn, platform_.yaw_rate_radps, platform_.yaw_accel_radps2);
+    heading = wrap_angle(heading + turn);
+    std::vector<Eigen::Vector2d> pts;
+    for (std::size_t k = first; k <= i; ++k) pts.push_back(wp[k].p);
+    PushedRun run(fillet_polyline(pts, motion.corner_radius_m), route.speed_mps,
+                  platform_.accel_mps2, motion, rng);
+    const Pose2 start(wp[first].p.x(), wp[first].p.y(), heading);
+    add_run(std::move(run), start);
+    heading = heading_of(i - 1);
+    pose = Pose2(wp[i].p.x(), wp[i].p.y(), heading);
+    if (wp[i].stop) add(Kind::kPause, pose, route.stop_s, 0, 0);
+    first = i;
+  }
+  add(Kind::kPause, pose, route.end_pause_s, 0, 0);
 }
 
 Trajectory::State Trajectory::nominal_state(double t) const {
@@ -99,12 +177,18 @@ Trajectory::State Trajectory::nominal_state(double t) const {
   const double tau = t - s.t0;
   switch (s.kind) {
     case Kind::kPause:
-      return {s.start, s.dist0, 0.0};
+      return {s.start, s.dist0, 0.0, 0.0};
     case Kind::kLine: {
       double d, v;
       trapezoid_at(s.amount, s.vmax, s.accel, tau, d, v);
       const Pose2 p = s.start * Pose2(d, 0.0, 0.0);
-      return {p, s.dist0 + d, v};
+      return {p, s.dist0 + d, v, v};
+    }
+    case Kind::kRun: {
+      Pose2 p;
+      double d, v;
+      runs_[s.run].at(tau, p, d, v);
+      return {p, s.dist0 + d, v, v};
     }
     case Kind::kTurn:
     default: {
@@ -112,7 +196,7 @@ Trajectory::State Trajectory::nominal_state(double t) const {
       trapezoid_at(std::abs(s.amount), s.vmax, s.accel, tau, a, w);
       const double sign = s.amount < 0 ? -1.0 : 1.0;
       const Pose2 p(s.start.x(), s.start.y(), wrap_angle(s.start.theta() + sign * a));
-      return {p, s.dist0 + a * platform_.half_track_m, w * platform_.half_track_m};
+      return {p, s.dist0 + a * platform_.half_track_m, w * platform_.half_track_m, 0.0};
     }
   }
 }
@@ -131,5 +215,23 @@ Pose2 Trajectory::pose(double t) const {
   }
   return st.pose * Pose2(offset[0], offset[1], offset[2]);
 }
+
+}  // namespace traverse::sim
+
+namespace traverse::sim {
+
+Eigen::Isometry3d Trajectory::lift(const Pose2& p) const {
+  CartAttitude a;
+  if (floor_) a = floor_->attitude(p);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(p.theta(), Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(a.pitch, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(a.roll, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(p.x(), p.y(), a.z);
+  return T;
+}
+
+Eigen::Isometry3d Trajectory::pose3(double t) const { return lift(pose(t)); }
 
 }  // namespace traverse::sim

@@ -5,15 +5,37 @@
 // with the distance rolled by the wheels (wheel out-of-roundness, floor tiles), so its frequency
 // follows the speed and it dies out when the cart stands still. The ground truth is the nominal
 // pose composed with the vibration, evaluated exactly at any time.
+// With the realistic profile's motion effect the cart is pushed instead (pushed_path.hpp): corners
+// are driven as arcs and only stops and reversals are turned on the spot; with its floor effect
+// the cart also rises, pitches and rolls on the floor (floor.hpp), giving a 6-DoF pose.
 #pragma once
 
+#include <Eigen/Geometry>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "effects.hpp"
+#include "floor.hpp"
+#include "pushed_path.hpp"
 #include "rng.hpp"
 #include "se2.hpp"
 
 namespace traverse::sim {
+
+// Extra waypoints driven only with a world layer (a detour into a part of the world that only
+// that layer builds): inserted after waypoint `after`.
+struct DetourSpec {
+  std::string layer = "realistic";
+  int after = 0;
+  std::vector<std::vector<double>> waypoints;  // [m] [[x, y], ...] in world
+  template <class V>
+  void visit(V& v) {
+    v("layer", layer);
+    v("after", after);
+    v("waypoints", waypoints);
+  }
+};
 
 // configs/routes/*.yaml
 struct RouteSpec {
@@ -26,6 +48,7 @@ struct RouteSpec {
   double end_pause_s = 2.0;        // [s] standing still at the end
   std::vector<int> stop_at;        // waypoint indices where the cart also pauses
   double stop_s = 3.0;             // [s] length of those pauses
+  std::vector<DetourSpec> detours;
   template <class V>
   void visit(V& v) {
     v("world", world);
@@ -37,8 +60,16 @@ struct RouteSpec {
     v("end_pause_s", end_pause_s);
     v("stop_at", stop_at);
     v("stop_s", stop_s);
+    v("detours", detours);
   }
 };
+
+// A route's waypoints with the detours of the named layers, and whether the cart pauses there.
+struct Waypoint {
+  Eigen::Vector2d p;
+  bool stop = false;
+};
+std::vector<Waypoint> expand_route(const RouteSpec& route, const std::vector<std::string>& layers);
 
 // One vibration component, added in the base frame.
 struct VibrationSpec {
@@ -80,8 +111,10 @@ struct PlatformConfig {
 class Trajectory {
  public:
   // Throws std::runtime_error for an unusable route (fewer than 2 waypoints, bad speed).
-  // `rng` draws the vibration phases.
-  Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng);
+  // `rng` draws the vibration phases (and the pushed cart's speed and weave). `effects` selects
+  // the motion (pushed or stop-and-turn) and the detours of its world layers.
+  Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng,
+             const Effects& effects = Effects{}.ideal());
 
   double duration_s() const { return segments_.empty() ? 0.0 : segments_.back().t1; }
   double length_m() const { return length_m_; }  // [m] driven on straight legs
@@ -90,9 +123,18 @@ class Trajectory {
   Pose2 pose(double t) const;
   // Nominal pose without vibration.
   Pose2 nominal_pose(double t) const;
+  // [m/s] nominal speed of the cart's centre, and [m] wheel travel so far.
+  double nominal_speed(double t) const { return nominal_state(t).speed; }
+
+  // The floor the wheels roll on (none: a plane floor, the cart stays level).
+  void set_floor(std::shared_ptr<const FloorModel> floor) { floor_ = std::move(floor); }
+  // True pose T_world_base in 3D: the planar pose, lifted and tilted by the floor.
+  Eigen::Isometry3d pose3(double t) const;
+  // The same from a planar pose.
+  Eigen::Isometry3d lift(const Pose2& T_world_base) const;
 
  private:
-  enum class Kind { kPause, kLine, kTurn };
+  enum class Kind { kPause, kLine, kTurn, kRun };
   struct Segment {
     Kind kind;
     double t0, t1;       // [s]
@@ -100,15 +142,25 @@ class Trajectory {
     double amount;       // [m] length (line) or [rad] signed angle (turn)
     double vmax, accel;  // [m/s, m/s^2] or [rad/s, rad/s^2]
     double dist0;        // [m] wheel travel before t0
+    int run = -1;        // index into runs_ (kRun)
   };
   struct State {
     Pose2 pose;
     double dist;         // [m] wheel travel
     double wheel_speed;  // [m/s]
+    double speed = 0.0;  // [m/s] of the centre
   };
   State nominal_state(double t) const;
   void add(Kind kind, const Pose2& start, double amount, double vmax, double accel);
+  // Adds the start pause; returns the starting pose.
+  Pose2 start(const RouteSpec& route, const std::vector<Waypoint>& wp);
+  void plan_stop_and_turn(const RouteSpec& route, const std::vector<Waypoint>& wp);
+  void plan_pushed(const RouteSpec& route, const std::vector<Waypoint>& wp,
+                   const MotionEffect& motion, Rng& rng);
+  void add_run(PushedRun run, const Pose2& start);
 
+  std::vector<PushedRun> runs_;
+  std::shared_ptr<const FloorModel> floor_;
   std::vector<Segment> segments_;
   PlatformConfig platform_;
   std::vector<double> phases_;

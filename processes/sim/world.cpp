@@ -58,7 +58,39 @@ bool segment_touches_box(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 
 }  // namespace
 
-World::World(const WorldSpec& spec, double cell_size_m) : name_(spec.name), cell_(cell_size_m) {
+bool layer_active(const std::string& layer, const std::optional<std::vector<std::string>>& layers) {
+  if (layer.empty() || !layers) return true;
+  const bool negated = layer[0] == '!';
+  const std::string name = negated ? layer.substr(1) : layer;
+  const bool named = std::find(layers->begin(), layers->end(), name) != layers->end();
+  return negated != named;
+}
+
+void intersect_cylinder(const Cylinder& c, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                        double t_min, double& best_t, RayHit& best) {
+  const Eigen::Vector2d f = o.head<2>() - c.c, dxy = d.head<2>();
+  const double a = dxy.squaredNorm();
+  if (a < 1e-18) return;
+  const double b = f.dot(dxy), cc = f.squaredNorm() - c.r * c.r;
+  const double disc = b * b - a * cc;
+  if (disc < 0.0) return;
+  const double sq = std::sqrt(disc);
+  for (const double t : {(-b - sq) / a, (-b + sq) / a}) {
+    if (t <= t_min || t >= best_t) continue;
+    const double z = o.z() + t * d.z();
+    if (z < c.z0 || z > c.z1) continue;
+    const Eigen::Vector2d q = o.head<2>() + t * dxy - c.c;
+    Eigen::Vector3d n(q.x() / c.r, q.y() / c.r, 0.0);
+    if (n.dot(d) > 0) n = -n;
+    best_t = t;
+    best = {t, n, c.material};
+    return;
+  }
+}
+
+World::World(const WorldSpec& spec, double cell_size_m, const WorldOptions& options)
+    : name_(spec.name), cell_(cell_size_m) {
+  const auto& layers = options.layers;
   for (const auto& m : spec.materials) {
     if (m.reflectivity < 0.0 || m.reflectivity > 1.0 || m.p_return < 0.0 || m.p_mirror < 0.0 ||
         m.p_return + m.p_mirror > 1.0 + 1e-9)
@@ -83,6 +115,7 @@ World::World(const WorldSpec& spec, double cell_size_m) : name_(spec.name), cell
     ceiling_material_ = mat(spec.ceiling_material);
   }
   for (const auto& w : spec.walls) {
+    if (!layer_active(w.layer, layers)) continue;
     const auto [z0, z1] = zrange(w.z, "a wall");
     const int m = mat(w.material);
     std::vector<Eigen::Vector2d> pts;
@@ -96,18 +129,21 @@ World::World(const WorldSpec& spec, double cell_size_m) : name_(spec.name), cell
     if (w.closed && pts.size() > 2) faces_.push_back({pts.back(), pts.front(), z0, z1, m});
   }
   for (const auto& p : spec.pillars) {
+    if (!layer_active(p.layer, layers)) continue;
     const auto [z0, z1] = zrange(p.z, "pillar " + p.id);
     if (p.radius <= 0.0) throw std::runtime_error("pillar " + p.id + ": radius must be > 0");
     cylinders_.push_back({{p.x, p.y}, p.radius, z0, z1, mat(p.material)});
   }
-  for (const auto* list : {&spec.boxes, &spec.shelves}) {
-    for (const auto& b : *list) {
-      if (b.size.size() != 3 || b.size[0] <= 0 || b.size[1] <= 0 || b.size[2] <= 0)
-        throw std::runtime_error("world '" + name_ + "': box size needs [length, width, height]");
-      add_box({b.x, b.y}, b.yaw, b.size[0], b.size[1], b.z0, b.z0 + b.size[2], mat(b.material));
-    }
-  }
+  auto box = [&](const BoxSpec& b, Lifetime life) {
+    if (b.size.size() != 3 || b.size[0] <= 0 || b.size[1] <= 0 || b.size[2] <= 0)
+      throw std::runtime_error("world '" + name_ + "': box size needs [length, width, height]");
+    add_box({b.x, b.y}, b.yaw, b.size[0], b.size[1], b.z0, b.z0 + b.size[2], mat(b.material), life);
+  };
+  for (const auto* list : {&spec.boxes, &spec.shelves})
+    for (const auto& b : *list)
+      if (layer_active(b.layer, layers)) box(b, {});
   for (const auto& d : spec.desks) {
+    if (!layer_active(d.layer, layers)) continue;
     if (d.size.size() != 2) throw std::runtime_error("world '" + name_ + "': desk size [l, w]");
     const Eigen::Vector2d c(d.x, d.y), u(std::cos(d.yaw), std::sin(d.yaw)), v(-u.y(), u.x());
     const double top0 = floor_z_ + d.height - d.top_thickness;
@@ -117,6 +153,22 @@ World::World(const WorldSpec& spec, double cell_size_m) : name_(spec.name), cell
       for (const double sv : {-1.0, 1.0})
         cylinders_.push_back(
             {c + su * lu * u + sv * lv * v, d.leg_radius, floor_z_, top0, mat(d.leg_material)});
+  }
+  for (const auto& m : spec.movables) {
+    if (m.pass != "first" && m.pass != "second")
+      throw std::runtime_error("world '" + name_ + "': movable '" + m.id +
+                               "' needs pass: first or second");
+    if (!layer_active(m.box.layer, layers)) continue;
+    const bool first = m.pass == "first";
+    Lifetime life;  // every movable always: the union an evaluator compares with
+    if (options.swap_times) {
+      const auto it = options.swap_times->find(m.id);
+      const double swap = it == options.swap_times->end() ? kInf : it->second;
+      (first ? life.to : life.from) = swap;
+    } else if (layers && !first) {
+      continue;  // named layers without world changes: the first pass only
+    }
+    box(m.box, life);
   }
   build_grid();
 }
@@ -128,13 +180,13 @@ int World::material_index(const std::string& name) const {
 }
 
 void World::add_box(const Eigen::Vector2d& c, double yaw, double lx, double ly, double z0,
-                    double z1, int material) {
+                    double z1, int material, Lifetime life) {
   const Eigen::Vector2d u(std::cos(yaw), std::sin(yaw)), v(-u.y(), u.x());
   const Eigen::Vector2d p[4] = {c - lx / 2 * u - ly / 2 * v, c + lx / 2 * u - ly / 2 * v,
                                 c + lx / 2 * u + ly / 2 * v, c - lx / 2 * u + ly / 2 * v};
-  for (int i = 0; i < 4; ++i) faces_.push_back({p[i], p[(i + 1) % 4], z0, z1, material});
-  slabs_.push_back({c, u, lx / 2, ly / 2, z1, material});
-  if (z0 > floor_z_ + 1e-6) slabs_.push_back({c, u, lx / 2, ly / 2, z0, material});
+  for (int i = 0; i < 4; ++i) faces_.push_back({p[i], p[(i + 1) % 4], z0, z1, material, life});
+  slabs_.push_back({c, u, lx / 2, ly / 2, z1, material, life});
+  if (z0 > floor_z_ + 1e-6) slabs_.push_back({c, u, lx / 2, ly / 2, z0, material, life});
 }
 
 void World::build_grid() {
@@ -199,7 +251,7 @@ void World::build_grid() {
 }
 
 void World::test_cell(int cell, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min,
-                      double& best_t, RayHit& best) const {
+                      double time_s, double& best_t, RayHit& best) const {
   const Eigen::Vector2d oxy = o.head<2>(), dxy = d.head<2>();
   for (uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
     const uint32_t id = items_[k];
@@ -207,6 +259,7 @@ void World::test_cell(int cell, const Eigen::Vector3d& o, const Eigen::Vector3d&
     switch (id & kKindMask) {
       case kFace: {
         const Face& f = faces_[i];
+        if (!f.life.at(time_s)) break;
         const Eigen::Vector2d e = f.b - f.a;
         const double denom = cross(dxy, e);
         if (std::abs(denom) < 1e-15) break;
@@ -226,29 +279,12 @@ void World::test_cell(int cell, const Eigen::Vector3d& o, const Eigen::Vector3d&
       }
       case kCylinder: {
         const Cylinder& c = cylinders_[i];
-        const Eigen::Vector2d f = oxy - c.c;
-        const double a = dxy.squaredNorm();
-        if (a < 1e-18) break;
-        const double b = f.dot(dxy), cc = f.squaredNorm() - c.r * c.r;
-        const double disc = b * b - a * cc;
-        if (disc < 0.0) break;
-        const double sq = std::sqrt(disc);
-        for (const double t : {(-b - sq) / a, (-b + sq) / a}) {
-          if (t <= t_min || t >= best_t) continue;
-          const double z = o.z() + t * d.z();
-          if (z < c.z0 || z > c.z1) continue;
-          const Eigen::Vector2d q = oxy + t * dxy - c.c;
-          Eigen::Vector3d n(q.x() / c.r, q.y() / c.r, 0.0);
-          if (n.dot(d) > 0) n = -n;
-          best_t = t;
-          best = {t, n, c.material};
-          break;
-        }
+        if (c.life.at(time_s)) intersect_cylinder(c, o, d, t_min, best_t, best);
         break;
       }
       default: {
         const Slab& s = slabs_[i];
-        if (std::abs(d.z()) < 1e-12) break;
+        if (!s.life.at(time_s) || std::abs(d.z()) < 1e-12) break;
         const double t = (s.z - o.z()) / d.z();
         if (t <= t_min || t >= best_t) break;
         const Eigen::Vector2d q = oxy + t * dxy - s.c;
@@ -262,7 +298,7 @@ void World::test_cell(int cell, const Eigen::Vector3d& o, const Eigen::Vector3d&
 }
 
 std::optional<RayHit> World::raycast(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
-                                     double t_max, double t_min) const {
+                                     double t_max, double t_min, double time_s) const {
   double best_t = t_max;
   RayHit best;
   // Floor and ceiling are unbounded planes.
@@ -305,7 +341,7 @@ std::optional<RayHit> World::raycast(const Eigen::Vector3d& o, const Eigen::Vect
     const double dtx = std::abs(d.x()) < 1e-15 ? kInf : cell_ / std::abs(d.x());
     const double dty = std::abs(d.y()) < 1e-15 ? kInf : cell_ / std::abs(d.y());
     while (true) {
-      test_cell(cell_index(ix, iy), o, d, t_min, best_t, best);
+      test_cell(cell_index(ix, iy), o, d, t_min, time_s, best_t, best);
       const double t_exit = std::min(tx, ty);
       if (best_t <= t_exit || t_exit >= t1) break;
       if (tx < ty) {
@@ -359,15 +395,18 @@ double World::distance_to_surface(const Eigen::Vector3d& p, double max_search_m)
   return best;
 }
 
-double World::clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi) const {
+double World::clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi,
+                           std::optional<double> time_s) const {
   double best = kInf;
-  auto overlaps = [&](double z0, double z1) { return z0 <= z_hi && z1 >= z_lo; };
+  auto counts = [&](double z0, double z1, const Lifetime& life) {
+    return z0 <= z_hi && z1 >= z_lo && (!time_s || life.at(*time_s));
+  };
   for (const auto& f : faces_)
-    if (overlaps(f.z0, f.z1)) best = std::min(best, point_segment_distance(xy, f.a, f.b));
+    if (counts(f.z0, f.z1, f.life)) best = std::min(best, point_segment_distance(xy, f.a, f.b));
   for (const auto& c : cylinders_)
-    if (overlaps(c.z0, c.z1)) best = std::min(best, std::max(0.0, (xy - c.c).norm() - c.r));
+    if (counts(c.z0, c.z1, c.life)) best = std::min(best, std::max(0.0, (xy - c.c).norm() - c.r));
   for (const auto& s : slabs_)
-    if (overlaps(s.z, s.z)) best = std::min(best, slab_plane_distance(s, xy));
+    if (counts(s.z, s.z, s.life)) best = std::min(best, slab_plane_distance(s, xy));
   return best;
 }
 

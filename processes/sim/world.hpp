@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,11 +25,19 @@ struct Material {
   double p_mirror = 0.0;
 };
 
+// The time an item exists [s since the route's start]: always, unless it is a movable.
+struct Lifetime {
+  double from = -std::numeric_limits<double>::infinity();
+  double to = std::numeric_limits<double>::infinity();
+  bool at(double t) const { return t >= from && t < to; }
+};
+
 // A vertical rectangle between a and b (world xy) from z0 to z1.
 struct Face {
   Eigen::Vector2d a, b;
   double z0, z1;
   int material;
+  Lifetime life{};
 };
 
 // The side of a vertical cylinder.
@@ -35,6 +45,7 @@ struct Cylinder {
   Eigen::Vector2d c;
   double r, z0, z1;
   int material;
+  Lifetime life{};
 };
 
 // A horizontal rectangle at height z: centre, unit axis u (v = u rotated +90 deg), half sizes.
@@ -42,6 +53,7 @@ struct Slab {
   Eigen::Vector2d c, u;
   double hu, hv, z;
   int material;
+  Lifetime life{};
 };
 
 struct RayHit {
@@ -50,22 +62,42 @@ struct RayHit {
   int material = -1;
 };
 
+// Which of a WorldSpec's elements to build. By default every element of every layer and both
+// passes of every movable (what an evaluator compares a cloud with); the simulator names its
+// layers and, with world changes, the time each movable group swaps.
+struct WorldOptions {
+  std::optional<std::vector<std::string>> layers;  // nullopt: all layers
+  // Movable group id -> swap time [s]; nullopt: every movable always (with layers == nullopt) or
+  // first-pass movables only (with named layers).
+  std::optional<std::map<std::string, double>> swap_times;
+};
+
+// True when an element with `layer` exists with the named layers (nullopt: every element).
+bool layer_active(const std::string& layer, const std::optional<std::vector<std::string>>& layers);
+
+// Ray-cylinder intersection with t in (t_min, best_t): on a hit, updates best_t and best.
+void intersect_cylinder(const Cylinder& c, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                        double t_min, double& best_t, RayHit& best);
+
 class World {
  public:
   // Throws std::runtime_error for inconsistent data (unknown material, bad sizes).
-  explicit World(const WorldSpec& spec, double cell_size_m = 0.5);
+  explicit World(const WorldSpec& spec, double cell_size_m = 0.5, const WorldOptions& options = {});
 
-  // Nearest intersection of origin + t * dir (dir unit length) with t in (t_min, t_max].
+  // Nearest intersection of origin + t * dir (dir unit length) with t in (t_min, t_max], with the
+  // items that exist at `time_s` [s since the route's start].
   std::optional<RayHit> raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                                double t_max, double t_min = 1e-6) const;
+                                double t_max, double t_min = 1e-6, double time_s = 0.0) const;
 
   // [m] Euclidean distance from p to the nearest true surface (floor and ceiling included),
   // searching surfaces within max_search_m; returns max_search_m when none is closer.
   double distance_to_surface(const Eigen::Vector3d& p, double max_search_m = 2.0) const;
 
   // [m] horizontal distance from (x, y) to the nearest obstacle whose height range overlaps
-  // [z_lo, z_hi] (walls, pillars, furniture; not floor or ceiling), searching all objects.
-  double clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi) const;
+  // [z_lo, z_hi] (walls, pillars, furniture; not floor or ceiling), searching all objects (with
+  // `time_s`, those that exist then).
+  double clearance_2d(const Eigen::Vector2d& xy, double z_lo, double z_hi,
+                      std::optional<double> time_s = std::nullopt) const;
 
   const std::string& name() const { return name_; }
   const Material& material(int i) const { return materials_[i]; }
@@ -78,12 +110,13 @@ class World {
 
  private:
   void add_box(const Eigen::Vector2d& c, double yaw, double lx, double ly, double z0, double z1,
-               int material);
+               int material, Lifetime life = {});
   void build_grid();
   int cell_index(int ix, int iy) const { return iy * nx_ + ix; }
-  // Tests every item in cell `cell` against the ray, keeping the nearest hit in `best`.
+  // Tests every item in cell `cell` that exists at `time_s` against the ray, keeping the nearest
+  // hit in `best`.
   void test_cell(int cell, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min,
-                 double& best_t, RayHit& best) const;
+                 double time_s, double& best_t, RayHit& best) const;
 
   std::string name_;
   std::vector<Material> materials_;

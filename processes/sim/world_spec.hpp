@@ -34,12 +34,14 @@ struct WallSpec {
   std::vector<double> z = {0.0, 2.8};       // [m] bottom, top
   bool closed = false;                      // also joins the last point to the first
   std::string material = "wall";
+  std::string layer;  // see WorldSpec: "" always, "NAME" only with layer NAME, "!NAME" only without
   template <class V>
   void visit(V& v) {
     v("points", points);
     v("z", z);
     v("closed", closed);
     v("material", material);
+    v("layer", layer);
   }
 };
 
@@ -50,6 +52,7 @@ struct PillarSpec {
   double radius = 0.2;                 // [m]
   std::vector<double> z = {0.0, 2.8};  // [m] bottom, top
   std::string material = "concrete";
+  std::string layer;
   template <class V>
   void visit(V& v) {
     v("id", id);
@@ -58,6 +61,7 @@ struct PillarSpec {
     v("radius", radius);
     v("z", z);
     v("material", material);
+    v("layer", layer);
   }
 };
 
@@ -68,6 +72,7 @@ struct BoxSpec {
   std::vector<double> size = {1, 1, 1};  // [m] length (along yaw), width, height
   double z0 = 0.0;                       // [m] bottom
   std::string material = "wood";
+  std::string layer;
   template <class V>
   void visit(V& v) {
     v("x", x);
@@ -76,6 +81,7 @@ struct BoxSpec {
     v("size", size);
     v("z0", z0);
     v("material", material);
+    v("layer", layer);
   }
 };
 
@@ -90,8 +96,10 @@ struct DeskSpec {
   double leg_inset = 0.05;                // [m] leg centre from the top's edges
   std::string material = "wood";
   std::string leg_material = "metal";
+  std::string layer;
   template <class V>
   void visit(V& v) {
+    v("layer", layer);
     v("x", x);
     v("y", y);
     v("yaw", yaw);
@@ -105,6 +113,72 @@ struct DeskSpec {
   }
 };
 
+// A box that is there on only one pass of a place (a door closed on the second pass, a chair
+// moved): with the simulator's world changes, `pass: first` boxes vanish and `pass: second` boxes
+// appear between the cart's first and second visit near them (boxes sharing an `id` swap at the
+// same time). Without world changes, first-pass boxes stay and second-pass boxes never come.
+struct MovableSpec {
+  std::string id;              // swap group
+  std::string pass = "first";  // first or second
+  BoxSpec box;
+  template <class V>
+  void visit(V& v) {
+    v("id", id);
+    v("pass", pass);
+    v("box", box);
+  }
+};
+
+// A door threshold: a raised strip across a doorway from `a` to `b` (world xy), `height` above
+// the floor and `width` wide, with bevelled edges; a wheel climbs it as a smooth ramp.
+struct ThresholdSpec {
+  std::vector<double> a = {0, 0}, b = {1, 0};  // [m] ends in world
+  double height = 0.015;                       // [m] 10-20 mm is usual for door thresholds
+  double width = 0.06;                         // [m] top width
+  double bevel = 0.03;                         // [m] horizontal length of each ramp
+  template <class V>
+  void visit(V& v) {
+    v("a", a);
+    v("b", b);
+    v("height", height);
+    v("width", width);
+    v("bevel", bevel);
+  }
+};
+
+// A gentle floor ramp: along the segment from `a` to `b` (world xy) over `width` across it, the
+// floor rises at `slope_rad` for the first half and falls back for the second half (a hump, so the
+// floor outside stays at floor_z, the height the scanners' beams meet).
+struct RampSpec {
+  std::vector<double> a = {0, 0}, b = {1, 0};  // [m] ends in world
+  double width = 2.0;                          // [m] across the segment
+  double slope_rad = 0.0087;                   // [rad] 0.5 deg
+  template <class V>
+  void visit(V& v) {
+    v("a", a);
+    v("b", b);
+    v("width", width);
+    v("slope_rad", slope_rad);
+  }
+};
+
+// The floor as the cart's wheels feel it (the simulator's floor model; the scanners still see
+// the plane floor_z): square tiles whose joints step by a few mm, thresholds and ramps.
+struct FloorSpec {
+  double tile_size_m = 0.6;  // [m] edge of the square floor tiles (0: no tiles)
+  std::vector<ThresholdSpec> thresholds;
+  std::vector<RampSpec> ramps;
+  template <class V>
+  void visit(V& v) {
+    v("tile_size_m", tile_size_m);
+    v("thresholds", thresholds);
+    v("ramps", ramps);
+  }
+};
+
+// Elements with `layer: NAME` exist only when the simulator runs with layer NAME (the realistic
+// profile uses layer "realistic"), those with `layer: "!NAME"` only without it; elements without a
+// layer always. Evaluators that build the world without naming layers get every element.
 struct WorldSpec {
   std::string name;
   std::string description;
@@ -118,6 +192,8 @@ struct WorldSpec {
   std::vector<BoxSpec> boxes;
   std::vector<BoxSpec> shelves;
   std::vector<DeskSpec> desks;
+  std::vector<MovableSpec> movables;
+  FloorSpec floor;
   template <class V>
   void visit(V& v) {
     v("name", name);
@@ -132,6 +208,8 @@ struct WorldSpec {
     v("boxes", boxes);
     v("shelves", shelves);
     v("desks", desks);
+    v("movables", movables);
+    v("floor", floor);
   }
 };
 

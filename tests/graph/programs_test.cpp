@@ -14,8 +14,8 @@ namespace {
 // Programs that are not processes of the graph (no --config/--lcm-url contract). Everything else
 // in bin/traverse-* is a process.
 const std::set<std::string> kTools = {
-    "validate",  "launch",     "frontend-bench",    "pgo",
-    "pgo-ceres", "cloud-eval", "densifier-compare", "mapper-bench"};
+    "validate",          "launch",       "frontend-bench", "pgo", "pgo-ceres", "cloud-eval",
+    "densifier-compare", "mapper-bench", "sim-realism"};
 
 // Processes that need inputs besides a config to start at all get them here; the config must
 // still be checked, and named when wrong.

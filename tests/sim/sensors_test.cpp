@@ -17,7 +17,7 @@ WorldSpec wall_world(double reflectivity, double x = 10.0) {
   w.name = "wall";
   w.materials = {
       {"wall", reflectivity, 1.0, 0.0}, {"floor", 0.3, 1.0, 0.0}, {"glass", 0.08, 0.1, 0.0}};
-  w.walls = {{{{x, -60}, {x, 60}}, {0.0, 3.0}, false, "wall"}};
+  w.walls = {{{{x, -60}, {x, 60}}, {0.0, 3.0}, false, "wall", ""}};
   return w;
 }
 
@@ -33,7 +33,7 @@ RouteSpec standing_then_driving() {
 
 struct Rig {
   explicit Rig(const WorldSpec& spec, const RouteSpec& route = standing_then_driving())
-      : world(spec), rng(1), trajectory(route, PlatformConfig{}, rng) {}
+      : world(spec), rng(1), trajectory(route, PlatformConfig{}, rng, Effects{}.ideal()) {}
   World world;
   Rng rng;
   Trajectory trajectory;
@@ -94,14 +94,14 @@ TEST(Scanner, DarkDistantOrGrazingSurfacesDropOut) {
   EXPECT_GT(returns(wall_world(0.9, 30.0), -0.2, 0.2), 0.95);
   // A wall along the beams (y = 1): met at grazing incidence beyond 85 degrees for small angles.
   WorldSpec along = wall_world(0.9, 100.0);
-  along.walls.push_back({{{0.5, 1.0}, {60.0, 1.0}}, {0.0, 3.0}, false, "wall"});
+  along.walls.push_back({{{0.5, 1.0}, {60.0, 1.0}}, {0.0, 3.0}, false, "wall", ""});
   EXPECT_LT(returns(along, 0.025, 0.087), 0.35);  // incidence 85-88.6 deg
   EXPECT_GT(returns(along, 0.6, 1.0), 0.95);      // incidence 33-56 deg
 }
 
 TEST(Scanner, GlassPassesMostBeams) {
   WorldSpec spec = wall_world(0.9);
-  spec.walls.push_back({{{5.0, -60}, {5.0, 60}}, {0.0, 3.0}, false, "glass"});
+  spec.walls.push_back({{{5.0, -60}, {5.0, 60}}, {0.0, 3.0}, false, "glass", ""});
   Rig rig(spec);
   ScannerSim scanner(exact_offset_model(), Extrinsic{0, 0, 0.5, 0, 0, 0}, "laser_horizontal",
                      rig.world, rig.trajectory, rig.clock, Rng(2));
@@ -184,7 +184,7 @@ TEST(Simulator, StreamsHaveTheSensorsRatesSizesAndTimes) {
   RunOptions run;
   run.begin_s = 10.0;
   run.duration_s = 2.0;
-  Simulator sim(world, route, RigConfig{}, PlatformConfig{}, 1, 1000000000, run);
+  Simulator sim(world, route, RigConfig{}, PlatformConfig{}, 1, 1000000000, run, Effects{}.ideal());
   int counts[4] = {0, 0, 0, 0};
   int64_t last_utime = 0, prev_scan = -1;
   while (auto ev = sim.next()) {
@@ -228,7 +228,7 @@ TEST(Simulator, ScanPointsLieOnTheTrueSurfaces) {
   run.begin_s = 20.0;
   run.duration_s = 0.2;
   const RigConfig rig;
-  Simulator sim(world_spec, route, rig, PlatformConfig{}, 1, 0, run);
+  Simulator sim(world_spec, route, rig, PlatformConfig{}, 1, 0, run, Effects{}.ideal());
   int points = 0, on_surface = 0;
   while (auto ev = sim.next()) {
     if (ev->kind != SimEvent::Kind::kScanProfile && ev->kind != SimEvent::Kind::kScanHorizontal)

@@ -1,4 +1,4 @@
-// Runs the built traverse-sim program: same inputs and seed give byte-identical logs.
+// Runs the built traverse-sim program: same inputs, profile and seed give byte-identical logs.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -47,7 +47,14 @@ TEST(SimProgram, SameSeedGivesIdenticalLogsAndAnotherSeedDiffers) {
   EXPECT_TRUE(da == db);
   EXPECT_EQ(da.size(), dc.size());
   EXPECT_FALSE(da == dc);
-  for (const auto& p : {a, b, c}) std::filesystem::remove(p);
+  // The ideal profile is as deterministic, and a different log.
+  const std::string d = temp_path("d.lcmlog"), e = temp_path("e.lcmlog");
+  ASSERT_EQ(run(base + "--seed 1 --profile ideal --out " + d), 0);
+  ASSERT_EQ(run(base + "--seed 1 --profile ideal --out " + e), 0);
+  EXPECT_TRUE(read_all(d) == read_all(e));
+  EXPECT_FALSE(read_all(d) == da);
+  EXPECT_EQ(run(base + "--profile nope --out " + e), 2);  // a profile that does not exist
+  for (const auto& p : {a, b, c, d, e}) std::filesystem::remove(p);
 }
 
 TEST(SimProgram, HelpAndBadInputs) {

@@ -6,13 +6,15 @@
 #include <string>
 
 #include "config.hpp"
+#include "simulator.hpp"
 #include "world.hpp"
 
 namespace traverse::sim {
 namespace {
 
-const char* const kRoutes[] = {"office-x1", "office-x2",  "office-s1",      "office-s2",
-                               "office-s3", "court-loop", "corridor-return"};
+const char* const kRoutes[] = {"office-x1",       "office-x2",    "office-s1",
+                               "office-s2",       "office-s3",    "court-loop",
+                               "corridor-return", "office-rooms", "lab-loop"};
 
 RouteSpec load_route(const std::string& name) {
   RouteSpec r;
@@ -43,7 +45,7 @@ TEST(Routes, OfficeRoutesHaveThePapersLengthsSpeedsAndScanners) {
   for (const char* name : {"office-x1", "office-x2", "office-s1", "office-s2", "office-s3"}) {
     const RouteSpec r = load_route(name);
     Rng rng(1);
-    const Trajectory traj(r, platform, rng);
+    const Trajectory traj(r, platform, rng, Effects{}.ideal());
     EXPECT_EQ(r.world, "office") << name;
     EXPECT_GE(traj.length_m(), 230.0) << name;
     EXPECT_LE(traj.length_m(), 310.0) << name;
@@ -58,20 +60,30 @@ TEST(Routes, OfficeRoutesHaveThePapersLengthsSpeedsAndScanners) {
 
 // The cart (about 0.6 m wide) never touches anything between the floor and 1.2 m.
 TEST(Routes, StayInFreeSpace) {
+  // Both profiles: the ideal cart stopping and turning in the ideal world, and the pushed cart
+  // (arcs, weave, detours into the bare corridor) in the realistic world with every movable.
   PlatformConfig platform;
-  for (const char* name : kRoutes) {
-    const RouteSpec r = load_route(name);
-    WorldSpec spec;
-    load_config("configs/worlds/" + r.world + ".yaml", spec);
-    const World world(spec);
-    Rng rng(1);
-    const Trajectory traj(r, platform, rng);
-    double worst = 1e9;
-    for (double t = 0.0; t <= traj.duration_s(); t += 0.1) {
-      const Pose2 p = traj.pose(t);
-      worst = std::min(worst, world.clearance_2d(p.translation(), 0.02, 1.2));
+  const Effects realistic;
+  for (const Effects& fx : {realistic.ideal(), realistic}) {
+    for (const char* name : kRoutes) {
+      const RouteSpec r = load_route(name);
+      WorldSpec spec;
+      load_config("configs/worlds/" + r.world + ".yaml", spec);
+      Rng rng(1);
+      const Trajectory traj(r, platform, rng, fx);
+      // The world of the profile's layers, with movables where they are at each moment.
+      WorldOptions opt;
+      opt.layers = fx.world_layers;
+      if (fx.world_changes.enabled)
+        opt.swap_times = movable_swap_times(spec, traj, fx.world_changes.visit_radius_m);
+      const World world(spec, 0.5, opt);
+      double worst = 1e9;
+      for (double t = 0.0; t <= traj.duration_s(); t += 0.1) {
+        const Pose2 p = traj.pose(t);
+        worst = std::min(worst, world.clearance_2d(p.translation(), 0.02, 1.2, t));
+      }
+      EXPECT_GE(worst, 0.4) << name << (fx.motion.enabled ? " realistic" : " ideal");
     }
-    EXPECT_GE(worst, 0.4) << name;
   }
 }
 
@@ -79,7 +91,7 @@ TEST(Trajectory, GroundTruthIsContinuousAndStartsAndEndsAtRest) {
   PlatformConfig platform;
   const RouteSpec r = load_route("office-s2");
   Rng rng(1);
-  const Trajectory traj(r, platform, rng);
+  const Trajectory traj(r, platform, rng, Effects{}.ideal());
   const double dt = 1e-3;
   Pose2 prev = traj.pose(0.0);
   double max_step = 0.0, max_turn = 0.0;
@@ -103,7 +115,7 @@ TEST(Trajectory, VibratesByAFewMillimetresAroundTheNominalPath) {
   PlatformConfig platform;
   const RouteSpec r = load_route("corridor-return");
   Rng rng(3);
-  const Trajectory traj(r, platform, rng);
+  const Trajectory traj(r, platform, rng, Effects{}.ideal());
   double max_offset = 0.0, max_yaw = 0.0;
   for (double t = 0.0; t <= traj.duration_s(); t += 0.01) {
     const Pose2 d = between(traj.nominal_pose(t), traj.pose(t));

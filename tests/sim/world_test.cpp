@@ -18,9 +18,9 @@ WorldSpec one_room() {
   w.name = "room";
   w.ceiling_z = 3.0;
   w.materials = {{"wall", 0.7, 1.0, 0.0}, {"floor", 0.3, 1.0, 0.0}, {"ceiling", 0.8, 1.0, 0.0}};
-  w.walls = {{{{10, -5}, {10, 5}}, {0.0, 2.0}, false, "wall"}};
-  w.pillars = {{"P1", 5.0, 2.0, 0.5, {0.0, 2.0}, "wall"}};
-  w.boxes = {{3.0, -2.0, 0.0, {1.0, 1.0, 1.0}, 0.0, "wall"}};
+  w.walls = {{{{10, -5}, {10, 5}}, {0.0, 2.0}, false, "wall", ""}};
+  w.pillars = {{"P1", 5.0, 2.0, 0.5, {0.0, 2.0}, "wall", ""}};
+  w.boxes = {{3.0, -2.0, 0.0, {1.0, 1.0, 1.0}, 0.0, "wall", ""}};
   return w;
 }
 
