@@ -252,7 +252,7 @@ TEST_P(CarmenBackend, FullGraphNoWorseThanFrontendAndNoFalseClosure) {
   BackendNodeConfig node_config;
   const char* config_path = std::getenv("TRAVERSE_BACKEND_CONFIG");
   load_config(config_path ? config_path : "configs/backend.yaml", node_config);
-  ASSERT_EQ(validate(node_config), "");
+  ASSERT_EQ(validate(node_config), std::nullopt);
   densifier::DensifierConfig densifier_config;
   load_config("configs/densifier.yaml", densifier_config);
   evaluator::EvaluatorConfig eval_config;
