@@ -37,13 +37,26 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
   bus_.subscribe<planar_scan_t>(config_.scan_channel,
                                 [this](const planar_scan_t& m) { on_scan(m); });
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
+  if (!config_.odometry_channel.empty()) {
+    bus_.subscribe<odometry_t>(config_.odometry_channel,
+                               [this](const odometry_t& m) { on_odometry(m); });
+  }
+}
+
+void BackendNode::on_odometry(const odometry_t& msg) {
+  if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
+  backend_.add_odometry(msg.utime, Pose2(msg.x, msg.y, msg.theta));
 }
 
 void BackendNode::on_scan(const planar_scan_t& msg) { backend_.add_scan(to_planar_scan(msg)); }
 
 void BackendNode::on_pose(const pose2d_t& msg) {
   if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
-  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta))) publish(*update);
+  Eigen::Matrix3d covariance;
+  for (int i = 0; i < 9; ++i) covariance(i / 3, i % 3) = msg.covariance[i];
+  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta), covariance)) {
+    publish(*update);
+  }
 }
 
 void BackendNode::finish() {
@@ -53,7 +66,7 @@ void BackendNode::finish() {
 bool BackendNode::changed(int i) const {
   if (i >= static_cast<int>(published_.size())) return true;
   const Published& p = published_[i];
-  const Pose2& T = backend_.graph().poses[i];
+  const Pose2& T = backend_.key_poses()[i].T_world_base;
   if ((T.translation() - p.T_world_base.translation()).norm() > config_.publish_move_m) return true;
   if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
     return true;
@@ -76,7 +89,7 @@ void BackendNode::publish(const BackendUpdate& update) {
     if (changed(i)) changed_ids.push_back(i);
   }
   published_.resize(keys.size());
-  for (int i : changed_ids) published_[i] = {graph.poses[i], keys[i].covariance.diagonal()};
+  for (int i : changed_ids) published_[i] = {keys[i].T_world_base, keys[i].covariance.diagonal()};
 
   const int per = config_.max_poses_per_message;
   const int parts = std::max(1, static_cast<int>((changed_ids.size() + per - 1) / per));
@@ -98,9 +111,9 @@ void BackendNode::publish(const BackendUpdate& update) {
       key_pose_t p{};
       p.utime = keys[i].utime;
       p.id = i;
-      p.x = graph.poses[i].x();
-      p.y = graph.poses[i].y();
-      p.theta = graph.poses[i].theta();
+      p.x = keys[i].T_world_base.x();
+      p.y = keys[i].T_world_base.y();
+      p.theta = keys[i].T_world_base.theta();
       copy_matrix(keys[i].covariance, p.covariance);
       msg.poses.push_back(p);
     }
@@ -134,9 +147,9 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.utime = keys[i].utime;
     pose.parent_frame = "world";
     pose.child_frame = "base";
-    pose.x = graph.poses[i].x();
-    pose.y = graph.poses[i].y();
-    pose.theta = graph.poses[i].theta();
+    pose.x = keys[i].T_world_base.x();
+    pose.y = keys[i].T_world_base.y();
+    pose.theta = keys[i].T_world_base.theta();
     copy_matrix(keys[i].covariance, pose.covariance);
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
@@ -147,15 +160,23 @@ void BackendNode::report_counters() {
   if (!counters_) return;
   const BackendCounters& c = backend_.counters();
   const LoopCloserCounters& l = backend_.loop_counters();
-  counters_("poses_received", static_cast<double>(c.poses));
+  counters_("poses_received", static_cast<double>(c.prep.poses));
+  counters_("poses_out_of_order", static_cast<double>(c.prep.out_of_order));
+  counters_("poses_sparse", static_cast<double>(c.prep.sparse_poses));
   counters_("scans_received", static_cast<double>(c.scans));
-  counters_("jumps_smoothed", static_cast<double>(c.jumps_smoothed));
-  counters_("outliers_replaced", static_cast<double>(c.outliers_replaced));
+  counters_("jumps_smoothed", static_cast<double>(c.prep.jumps_smoothed));
+  counters_("outliers_replaced", static_cast<double>(c.prep.outliers_replaced));
   counters_("key_poses", static_cast<double>(backend_.key_poses().size()));
   counters_("key_poses_without_scan", static_cast<double>(c.key_poses_without_scan));
   counters_("links_matched", static_cast<double>(c.links_matched));
   counters_("links_fallback", static_cast<double>(c.links_fallback));
   counters_("links_refined", static_cast<double>(c.links_refined));
+  const OdometryCounters& o = backend_.odometry_counters();
+  counters_("odometry_readings", static_cast<double>(o.readings));
+  counters_("odometry_out_of_order", static_cast<double>(o.readings_out_of_order));
+  counters_("odometry_steps_checked", static_cast<double>(o.steps_checked));
+  counters_("odometry_steps_contradicted", static_cast<double>(o.steps_contradicted));
+  counters_("frontend_steps_replaced_by_odometry", static_cast<double>(c.frontend_steps_replaced));
   counters_("loop_closures", static_cast<double>(backend_.closures().size()));
   counters_("loop_episodes", static_cast<double>(l.episodes));
   counters_("loop_candidates", static_cast<double>(l.candidates));
@@ -165,6 +186,7 @@ void BackendNode::report_counters() {
   counters_("loop_refined", static_cast<double>(l.refined));
   counters_("loop_refine_failed", static_cast<double>(l.refine_failed));
   counters_("loop_rejected_inconsistent", static_cast<double>(l.rejected_inconsistent));
+  counters_("loop_rejected_graph", static_cast<double>(c.closures_rejected_inconsistent));
   counters_("optimisations", static_cast<double>(c.optimisations));
   counters_("optimisations_failed", static_cast<double>(c.optimisations_failed));
   counters_("optimisation_last_s", c.last_optimisation_s);

@@ -12,6 +12,7 @@
 #include "backend.hpp"
 #include "bus.hpp"
 #include "channels.hpp"
+#include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
 
@@ -20,6 +21,7 @@ namespace traverse::backend {
 struct BackendNodeConfig {
   std::string scan_channel = channels::kScanHorizontal;
   std::string pose_channel = channels::kPoseFrontend;
+  std::string odometry_channel = channels::kOdometry;  // odometry_t; empty: none
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
   int max_poses_per_message = 400;          // 112 bytes each: 400 keep a part under 64 KB
@@ -32,6 +34,7 @@ struct BackendNodeConfig {
   void visit(V& v) {
     v("scan_channel", scan_channel);
     v("pose_channel", pose_channel);
+    v("odometry_channel", odometry_channel);
     v("key_poses_channel", key_poses_channel);
     v("trajectory_channel", trajectory_channel);
     v("max_poses_per_message", max_poses_per_message);
@@ -44,6 +47,9 @@ struct BackendNodeConfig {
 
 // An error message when a value is out of range, empty when the config is valid.
 std::optional<std::string> validate(const BackendNodeConfig& config);
+
+// traverse-backend's exit code when its input gave no trajectory (Backend::input_fault()).
+inline constexpr int kNoTrajectoryExitCode = 3;
 
 class BackendNode {
  public:
@@ -61,6 +67,7 @@ class BackendNode {
  private:
   void on_scan(const planar_scan_t& msg);
   void on_pose(const pose2d_t& msg);
+  void on_odometry(const odometry_t& msg);
   void publish(const BackendUpdate& update);
   bool changed(int index) const;
 
