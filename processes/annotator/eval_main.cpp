@@ -1,0 +1,189 @@
+// traverse-annotator-eval: the annotator's bounds on a recorded run against the simulator's ground
+// truth (coverage.hpp): coverage of the absolute and local 95 % bounds, the NEES of the backend's
+// raw covariances and the covariance scale it asks for, and the mean true point error per level
+// (seed 004's claim). Reads the newest KEY_POSES and ANNOTATIONS of every key pose, the ground
+// truth, and the horizontal scan of each key pose (its points are the points the key pose
+// placed). Prints a summary with units and one JSON object as the last line; --csv writes one row
+// per key pose.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "coverage.hpp"
+#include "json_escape.hpp"
+#include "lcm_log.hpp"
+#include "traverse/annotations_t.hpp"
+#include "traverse/key_poses_t.hpp"
+#include "traverse/planar_scan_t.hpp"
+#include "traverse/pose2d_t.hpp"
+
+namespace {
+
+using traverse::annotator::KeyRecord;
+
+template <class T>
+bool decode(const traverse::LogEvent& e, T& msg) {
+  return msg.decode(e.data.data(), 0, static_cast<int>(e.data.size())) ==
+         static_cast<int>(e.data.size());
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+struct Options {
+  std::string log, csv, key_poses = "KEY_POSES", annotations = "ANNOTATIONS",
+                        truth = "POSE_GROUND_TRUTH", scans = "SCAN_HORIZONTAL";
+  int points_every = 10;
+  double laser_x = 0.0, laser_y = 0.0, laser_yaw = 0.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"Annotator bounds against ground truth: coverage, NEES, point error per level"};
+  app.add_option("--log", o.log, "recorded run (LCM log)")->required();
+  app.add_option("--csv", o.csv, "write one row per key pose here");
+  app.add_option("--key-poses", o.key_poses, "key_poses_t channel");
+  app.add_option("--annotations", o.annotations, "annotations_t channel");
+  app.add_option("--truth", o.truth, "ground-truth pose2d_t channel");
+  app.add_option("--scans", o.scans, "horizontal planar_scan_t channel");
+  app.add_option("--points-every", o.points_every, "use every Nth beam of a key pose's scan")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--laser-x", o.laser_x, "[m] horizontal scanner in the base frame (rig.yaml)");
+  app.add_option("--laser-y", o.laser_y, "[m]");
+  app.add_option("--laser-yaw", o.laser_yaw, "[rad]");
+  CLI11_PARSE(app, argc, argv);
+
+  // Pass 1: the newest key poses and annotations, the ground truth.
+  std::map<int64_t, KeyRecord> keys;
+  std::vector<traverse::annotator::StampedTruth> truth;
+  double local_radius_m = 0.0;
+  std::string coloured_by = "none", standard;
+  std::vector<std::string> level_names;
+  int64_t events = 0;
+  try {
+    traverse::LogReader reader(o.log);
+    while (auto e = reader.next()) {
+      ++events;
+      if (e->channel == o.key_poses) {
+        traverse::key_poses_t m;
+        if (!decode(*e, m)) continue;
+        for (const auto& k : m.poses) {
+          KeyRecord& r = keys[k.id];
+          r.id = k.id;
+          r.utime = k.utime;
+          r.T_world_base = traverse::Pose2(k.x, k.y, k.theta);
+          for (int i = 0; i < 9; ++i) r.covariance(i / 3, i % 3) = k.covariance[i];
+        }
+      } else if (e->channel == o.annotations) {
+        traverse::annotations_t m;
+        if (!decode(*e, m)) continue;
+        local_radius_m = m.local_radius_m;
+        coloured_by = m.coloured_by;
+        standard = m.standard;
+        level_names.clear();
+        for (const auto& l : m.levels) level_names.push_back(l.name);
+        for (const auto& a : m.keys) {
+          KeyRecord& r = keys[a.id];
+          r.bound_m = a.bound_m;
+          r.local_bound_m = a.local_bound_m;
+          r.level = a.level;
+        }
+      } else if (e->channel == o.truth) {
+        traverse::pose2d_t m;
+        if (!decode(*e, m)) continue;
+        if (truth.empty() || m.utime > truth.back().utime) {
+          truth.push_back({m.utime, traverse::Pose2(m.x, m.y, m.theta)});
+        }
+      }
+    }
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "traverse-annotator-eval: %s\n", ex.what());
+    return 2;
+  }
+  // Pass 2: the scan of each key pose (a key pose's time is its scan's last point).
+  std::map<int64_t, int64_t> id_of_utime;
+  for (const auto& [id, k] : keys) id_of_utime[k.utime] = id;
+  const traverse::Pose2 T_base_laser(o.laser_x, o.laser_y, o.laser_yaw);
+  {
+    traverse::LogReader reader(o.log);
+    while (auto e = reader.next()) {
+      if (e->channel != o.scans) continue;
+      traverse::planar_scan_t m;
+      if (!decode(*e, m)) continue;
+      auto it = id_of_utime.find(m.utime_last);
+      if (it == id_of_utime.end()) continue;
+      auto& pts = keys[it->second].points_base;
+      pts.clear();
+      for (int i = 0; i < m.n_ranges; i += o.points_every) {
+        const double r = m.ranges[i];
+        if (!(r >= m.range_min && r <= m.range_max)) continue;
+        const double a = m.angle_first + i * m.angle_step;
+        pts.push_back(T_base_laser * Eigen::Vector2d(r * std::cos(a), r * std::sin(a)));
+      }
+    }
+  }
+  std::vector<KeyRecord> sorted;
+  for (auto& [id, k] : keys) sorted.push_back(std::move(k));
+  const auto r = traverse::annotator::evaluate_coverage(sorted, truth, local_radius_m);
+
+  if (!o.csv.empty()) {
+    std::ofstream csv(o.csv);
+    csv << "id,utime,bound_m,local_bound_m,level,sigma_max_raw_m\n";
+    for (const KeyRecord& k : sorted) {
+      const double l = k.covariance.topLeftCorner<2, 2>().trace();
+      csv << k.id << ',' << k.utime << ',' << num(k.bound_m) << ',' << num(k.local_bound_m) << ','
+          << k.level << ',' << num(std::sqrt(std::max(l, 0.0))) << '\n';
+    }
+  }
+  std::printf("key poses with ground truth and a bound: %d (of %zu)\n", r.key_poses, sorted.size());
+  std::printf("coverage of the 95 %% bound: %.3f (mean bound %.4f m, key pose RMSE %.4f m)\n",
+              r.coverage, r.mean_bound_m, r.position_rmse_m);
+  std::printf("local coverage (radius %.1f m): %.3f over %d key poses\n", local_radius_m,
+              r.local_coverage, r.local_key_poses);
+  std::printf("raw NEES (2 dof, 2 if consistent): mean %.3g, median %.3g, q95 %.3g\n", r.nees_mean,
+              r.nees_median, r.nees_q95);
+  std::string levels_json = "[";
+  for (const auto& f : r.levels) {
+    const std::string name =
+        f.level < static_cast<int>(level_names.size()) ? level_names[f.level] : "?";
+    std::printf(
+        "level %s: %d key poses, %lld points, mean true point error %.4f m, mean bound "
+        "%.4f m\n",
+        name.c_str(), f.key_poses, static_cast<long long>(f.points), f.mean_point_error_m,
+        f.mean_bound_m);
+    levels_json += std::string(levels_json.size() > 1 ? "," : "") + "{\"level\": \"" +
+                   traverse::json_escape(name) +
+                   "\", \"key_poses\": " + std::to_string(f.key_poses) +
+                   ", \"points\": " + std::to_string(f.points) +
+                   ", \"mean_point_error_m\": " + num(f.mean_point_error_m) +
+                   ", \"mean_bound_m\": " + num(f.mean_bound_m) + "}";
+  }
+  levels_json += "]";
+  std::string nees_json = "[";
+  for (std::size_t i = 0; i < r.nees.size(); ++i) nees_json += (i ? "," : "") + num(r.nees[i]);
+  nees_json += "]";
+  std::printf(
+      "{\"log\": \"%s\", \"events\": %lld, \"key_poses\": %d, \"coverage\": %s, "
+      "\"local_coverage\": "
+      "%s, \"local_key_poses\": %d, \"local_radius_m\": %s, \"position_rmse_m\": %s, "
+      "\"mean_bound_m\": %s, \"nees_mean\": %s, \"nees_median\": %s, \"nees_q95\": %s, "
+      "\"scale_by_mean\": %s, \"scale_by_q95\": %s, \"coloured_by\": \"%s\", \"standard\": \"%s\", "
+      "\"levels\": %s, \"levels_increasing\": %s, \"nees\": %s}\n",
+      traverse::json_escape(o.log).c_str(), static_cast<long long>(events), r.key_poses,
+      num(r.coverage).c_str(), num(r.local_coverage).c_str(), r.local_key_poses,
+      num(local_radius_m).c_str(), num(r.position_rmse_m).c_str(), num(r.mean_bound_m).c_str(),
+      num(r.nees_mean).c_str(), num(r.nees_median).c_str(), num(r.nees_q95).c_str(),
+      num(r.scale_by_mean).c_str(), num(r.scale_by_q95).c_str(),
+      traverse::json_escape(coloured_by).c_str(), traverse::json_escape(standard).c_str(),
+      levels_json.c_str(), r.levels_increasing ? "true" : "false", nees_json.c_str());
+  return r.key_poses > 0 ? 0 : 1;
+}
