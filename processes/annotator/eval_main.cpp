@@ -5,13 +5,25 @@
 // truth, and the horizontal scan of each key pose (its points are the points the key pose
 // placed). Prints a summary with units and one JSON object as the last line; --csv writes one row
 // per key pose.
+//
+// --recompute CONFIG runs the annotator node (configs/annotator.yaml or another) on the log's
+// KEY_POSES and POSE_GRAPH_EDGES, on an in-process bus, and evaluates its annotations instead of
+// the recorded ones: a new calibration is evaluated without running the graph again.
+// --compact OUT writes a small log holding only what this evaluation reads (the backend's and the
+// annotator's channels, the ground truth and the scans of the key poses), so a run's large log
+// need not be kept.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <lcm/lcm-cpp.hpp>
 #include <map>
+#include <memory>
 #include <set>
 
+#include "annotator_node.hpp"
+#include "bus.hpp"
+#include "config.hpp"
 #include "coverage.hpp"
 #include "json_escape.hpp"
 #include "lcm_log.hpp"
@@ -40,6 +52,7 @@ std::string num(double v) {
 struct Options {
   std::string log, csv, key_poses = "KEY_POSES", annotations = "ANNOTATIONS",
                         truth = "POSE_GROUND_TRUTH", scans = "SCAN_HORIZONTAL";
+  std::string recompute, compact, edges = "POSE_GRAPH_EDGES";
   int points_every = 10;
   double laser_x = 0.0, laser_y = 0.0, laser_yaw = 0.0;
 };
@@ -55,6 +68,9 @@ int main(int argc, char** argv) {
   app.add_option("--annotations", o.annotations, "annotations_t channel");
   app.add_option("--truth", o.truth, "ground-truth pose2d_t channel");
   app.add_option("--scans", o.scans, "horizontal planar_scan_t channel");
+  app.add_option("--recompute", o.recompute,
+                 "annotator config: recompute the annotations from the log's backend messages");
+  app.add_option("--compact", o.compact, "write the events this evaluation reads into this log");
   app.add_option("--points-every", o.points_every, "use every Nth beam of a key pose's scan")
       ->check(CLI::PositiveNumber);
   app.add_option("--laser-x", o.laser_x, "[m] horizontal scanner in the base frame (rig.yaml)");
@@ -62,17 +78,77 @@ int main(int argc, char** argv) {
   app.add_option("--laser-yaw", o.laser_yaw, "[rad]");
   CLI11_PARSE(app, argc, argv);
 
-  // Pass 1: the newest key poses and annotations, the ground truth.
   std::map<int64_t, KeyRecord> keys;
   std::vector<traverse::annotator::StampedTruth> truth;
   double local_radius_m = 0.0;
   std::string coloured_by = "none", standard;
   std::vector<std::string> level_names;
+  auto on_annotations = [&](const traverse::annotations_t& m) {
+    local_radius_m = m.local_radius_m;
+    coloured_by = m.coloured_by;
+    standard = m.standard;
+    level_names.clear();
+    for (const auto& l : m.levels) level_names.push_back(l.name);
+    for (const auto& a : m.keys) {
+      KeyRecord& r = keys[a.id];
+      r.bound_m = a.bound_m;
+      r.local_bound_m = a.local_bound_m;
+      r.level = a.level;
+    }
+  };
+  // --recompute: the annotator node on an in-process bus, fed the backend's messages.
+  std::unique_ptr<traverse::Bus> bus;
+  std::unique_ptr<traverse::annotator::AnnotatorNode> node;
+  if (!o.recompute.empty()) {
+    traverse::annotator::AnnotatorNodeConfig config;
+    try {
+      traverse::load_config(o.recompute, config);
+    } catch (const traverse::ConfigError& ex) {
+      std::fprintf(stderr, "traverse-annotator-eval: %s\n", ex.what());
+      return 2;
+    }
+    if (const std::string error = traverse::annotator::validate(config); !error.empty()) {
+      std::fprintf(stderr, "traverse-annotator-eval: %s: %s\n", o.recompute.c_str(), error.c_str());
+      return 2;
+    }
+    bus = std::make_unique<traverse::Bus>("memq://");
+    node = std::make_unique<traverse::annotator::AnnotatorNode>(*bus, config);
+    bus->subscribe<traverse::annotations_t>(config.annotations_channel, on_annotations, true);
+  }
+  auto handle_all = [&] {
+    while (bus->lcm().handleTimeout(0) > 0) {
+    }
+  };
+  std::unique_ptr<lcm::LogFile> compact;
+  if (!o.compact.empty()) {
+    compact = std::make_unique<lcm::LogFile>(o.compact, "w");
+    if (!compact->good()) {
+      std::fprintf(stderr, "traverse-annotator-eval: cannot write %s\n", o.compact.c_str());
+      return 2;
+    }
+  }
+  auto keep = [&](traverse::LogEvent& e) {
+    if (!compact) return;
+    lcm::LogEvent out;
+    out.eventnum = e.event_number;
+    out.timestamp = e.utime;
+    out.channel = e.channel;
+    out.datalen = static_cast<int32_t>(e.data.size());
+    out.data = e.data.data();
+    compact->writeEvent(&out);
+  };
+  // Pass 1: the newest key poses and annotations, the ground truth.
   int64_t events = 0;
   try {
     traverse::LogReader reader(o.log);
     while (auto e = reader.next()) {
       ++events;
+      const bool backend = e->channel == o.key_poses || e->channel == o.edges;
+      if (backend || e->channel == o.annotations || e->channel == o.truth) keep(*e);
+      if (node && backend) {
+        bus->lcm().publish(e->channel, e->data.data(), static_cast<unsigned>(e->data.size()));
+        handle_all();
+      }
       if (e->channel == o.key_poses) {
         traverse::key_poses_t m;
         if (!decode(*e, m)) continue;
@@ -83,20 +159,9 @@ int main(int argc, char** argv) {
           r.T_world_base = traverse::Pose2(k.x, k.y, k.theta);
           for (int i = 0; i < 9; ++i) r.covariance(i / 3, i % 3) = k.covariance[i];
         }
-      } else if (e->channel == o.annotations) {
+      } else if (e->channel == o.annotations && !node) {
         traverse::annotations_t m;
-        if (!decode(*e, m)) continue;
-        local_radius_m = m.local_radius_m;
-        coloured_by = m.coloured_by;
-        standard = m.standard;
-        level_names.clear();
-        for (const auto& l : m.levels) level_names.push_back(l.name);
-        for (const auto& a : m.keys) {
-          KeyRecord& r = keys[a.id];
-          r.bound_m = a.bound_m;
-          r.local_bound_m = a.local_bound_m;
-          r.level = a.level;
-        }
+        if (decode(*e, m)) on_annotations(m);
       } else if (e->channel == o.truth) {
         traverse::pose2d_t m;
         if (!decode(*e, m)) continue;
@@ -105,22 +170,22 @@ int main(int argc, char** argv) {
         }
       }
     }
-  } catch (const std::exception& ex) {
-    std::fprintf(stderr, "traverse-annotator-eval: %s\n", ex.what());
-    return 2;
-  }
-  // Pass 2: the scan of each key pose (a key pose's time is its scan's last point).
-  std::map<int64_t, int64_t> id_of_utime;
-  for (const auto& [id, k] : keys) id_of_utime[k.utime] = id;
-  const traverse::Pose2 T_base_laser(o.laser_x, o.laser_y, o.laser_yaw);
-  {
-    traverse::LogReader reader(o.log);
-    while (auto e = reader.next()) {
+    if (node) {
+      node->finish();
+      handle_all();
+    }
+    // Pass 2: the scan of each key pose (a key pose's time is its scan's last point).
+    std::map<int64_t, int64_t> id_of_utime;
+    for (const auto& [id, k] : keys) id_of_utime[k.utime] = id;
+    const traverse::Pose2 T_base_laser(o.laser_x, o.laser_y, o.laser_yaw);
+    traverse::LogReader scans(o.log);
+    while (auto e = scans.next()) {
       if (e->channel != o.scans) continue;
       traverse::planar_scan_t m;
       if (!decode(*e, m)) continue;
       auto it = id_of_utime.find(m.utime_last);
       if (it == id_of_utime.end()) continue;
+      keep(*e);
       auto& pts = keys[it->second].points_base;
       pts.clear();
       for (int i = 0; i < m.n_ranges; i += o.points_every) {
@@ -130,6 +195,9 @@ int main(int argc, char** argv) {
         pts.push_back(T_base_laser * Eigen::Vector2d(r * std::cos(a), r * std::sin(a)));
       }
     }
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "traverse-annotator-eval: %s\n", ex.what());
+    return 2;
   }
   std::vector<KeyRecord> sorted;
   for (auto& [id, k] : keys) sorted.push_back(std::move(k));
