@@ -53,6 +53,7 @@ struct Options {
   std::string log, csv, key_poses = "KEY_POSES", annotations = "ANNOTATIONS",
                         truth = "POSE_GROUND_TRUTH", scans = "SCAN_HORIZONTAL";
   std::string recompute, compact, edges = "POSE_GRAPH_EDGES";
+  bool compact_graph_only = false;
   int points_every = 10;
   double laser_x = 0.0, laser_y = 0.0, laser_yaw = 0.0;
 };
@@ -71,6 +72,8 @@ int main(int argc, char** argv) {
   app.add_option("--recompute", o.recompute,
                  "annotator config: recompute the annotations from the log's backend messages");
   app.add_option("--compact", o.compact, "write the events this evaluation reads into this log");
+  app.add_flag("--compact-graph-only", o.compact_graph_only,
+               "--compact keeps only the backend's and the annotator's channels");
   app.add_option("--points-every", o.points_every, "use every Nth beam of a key pose's scan")
       ->check(CLI::PositiveNumber);
   app.add_option("--laser-x", o.laser_x, "[m] horizontal scanner in the base frame (rig.yaml)");
@@ -144,7 +147,8 @@ int main(int argc, char** argv) {
     while (auto e = reader.next()) {
       ++events;
       const bool backend = e->channel == o.key_poses || e->channel == o.edges;
-      if (backend || e->channel == o.annotations || e->channel == o.truth) keep(*e);
+      if (backend || e->channel == o.annotations) keep(*e);
+      if (e->channel == o.truth && !o.compact_graph_only) keep(*e);
       if (node && backend) {
         bus->lcm().publish(e->channel, e->data.data(), static_cast<unsigned>(e->data.size()));
         handle_all();
@@ -185,7 +189,7 @@ int main(int argc, char** argv) {
       if (!decode(*e, m)) continue;
       auto it = id_of_utime.find(m.utime_last);
       if (it == id_of_utime.end()) continue;
-      keep(*e);
+      if (!o.compact_graph_only) keep(*e);
       auto& pts = keys[it->second].points_base;
       pts.clear();
       for (int i = 0; i < m.n_ranges; i += o.points_every) {
