@@ -7,7 +7,9 @@
 # first key pose, which fixes the frame) with its 95 % bound, the annotations recomputed from the
 # run's backend messages with the current configs/annotator.yaml. Prints per run the coverage (share
 # of key poses inside their bound), the local coverage, the raw NEES and the mean true point error
-# per accuracy level; the last line is JSON mapping each run name to {coverage, fitted, ...}.
+# per accuracy level, and the scale that run alone would need for 95 % coverage ("own scale": the
+# spread of these says how far one scale can serve every run); the last line is JSON mapping each
+# run name to {coverage, fitted, ...}.
 #   --fit            first fit covariance_scale on the fitting runs and write it into
 #                    configs/annotator.yaml: the scale at which 95 % of the pooled key poses' raw
 #                    NEES (e^T Sigma^-1 e with the backend's covariances) lie inside the chi-square
@@ -119,17 +121,19 @@ n = int(sys.argv[1])
 names, files, fitted = sys.argv[2:2 + n], sys.argv[2 + n:2 + 2 * n], sys.argv[2 + 2 * n:]
 out = {}
 print(f"{'run':24} {'fitted':6} {'key poses':>9} {'coverage':>8} {'local':>6} {'RMSE [m]':>9} "
-      f"{'mean bound [m]':>14} {'raw NEES q95':>12}  mean true point error per level [m]")
+      f"{'mean bound [m]':>14} {'raw NEES q95':>12} {'own scale':>9}  mean true point error per level [m]")
 for name, path, fit in zip(names, files, fitted):
     r = json.load(open(path))
     levels = ", ".join(f"{l['level']} {l['mean_point_error_m']:.4f} ({l['key_poses']})"
                        for l in r["levels"])
     print(f"{name:24} {fit:6} {r['key_poses']:9d} {r['coverage']:8.3f} {r['local_coverage']:6.3f} "
-          f"{r['position_rmse_m']:9.4f} {r['mean_bound_m']:14.4f} {r['nees_q95']:12.1f}  {levels}"
+          f"{r['position_rmse_m']:9.4f} {r['mean_bound_m']:14.4f} {r['nees_q95']:12.1f} "
+          f"{r['scale_by_coverage']:9.1f}  {levels}"
           f"{'' if r['levels_increasing'] else '  (not increasing)'}")
     out[name] = {"coverage": r["coverage"], "fitted": fit == "true",
                  "local_coverage": r["local_coverage"], "key_poses": r["key_poses"],
                  "position_rmse_m": r["position_rmse_m"], "mean_bound_m": r["mean_bound_m"],
+                 "scale_for_95": r["scale_by_coverage"], "covariance_scale": r["covariance_scale"],
                  "levels": r["levels"], "levels_increasing": r["levels_increasing"]}
 print(json.dumps(out))
 PY

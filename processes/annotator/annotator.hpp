@@ -35,7 +35,7 @@ struct AnnotatorConfig {
   // Levels best first and the upper ends of all but the last [m] (USIBD LOA 2016, at 95 %).
   std::vector<std::string> levels{"LOA50", "LOA40", "LOA30", "LOA20", "LOA10"};
   std::vector<double> limits_m{0.001, 0.005, 0.015, 0.050};
-  std::string best_level = "LOA20";    // green, with every better level
+  std::string best_level = "LOA30";    // green, with every better level
   std::string worst_level = "LOA10";   // red, with every worse level
   std::string bound = "exact";         // exact, chi2_max_eigen or paper (bounds.hpp)
   std::string colour_by = "absolute";  // absolute or local: the bound that gives level and colour

@@ -30,7 +30,8 @@ double quantile(std::vector<double> values, double q) {
 }
 
 CoverageResult evaluate_coverage(const std::vector<KeyRecord>& keys,
-                                 const std::vector<StampedTruth>& truth, double local_radius_m) {
+                                 const std::vector<StampedTruth>& truth, double local_radius_m,
+                                 double published_scale) {
   CoverageResult r;
   if (keys.empty()) return r;
   const auto truth0 = truth_at(truth, keys.front().utime);
@@ -53,6 +54,9 @@ CoverageResult evaluate_coverage(const std::vector<KeyRecord>& keys,
     se += e.squaredNorm();
     bounds += key.bound_m;
     if (e.norm() <= key.bound_m) ++inside;
+    if (key.bound_m > 0.0) {
+      r.needed_scale.push_back(e.squaredNorm() / (key.bound_m * key.bound_m) * published_scale);
+    }
     const Eigen::Matrix2d c = key.covariance.topLeftCorner<2, 2>();
     if (c.determinant() > 0.0) r.nees.push_back(e.dot(c.inverse() * e));
     // Local: the largest error of a neighbour's position in this key pose's frame.
@@ -97,6 +101,7 @@ CoverageResult evaluate_coverage(const std::vector<KeyRecord>& keys,
     r.scale_by_mean = r.nees_mean / 2.0;
     r.scale_by_q95 = r.nees_q95 / kChi2TwoDof95;
   }
+  r.scale_by_coverage = quantile(r.needed_scale, 0.95);
   r.levels_increasing = levels.size() >= 2;
   double previous = -1.0;
   for (auto& [level, f] : levels) {

@@ -5,6 +5,8 @@
 //     marginal covariances, e^T Sigma_xy^-1 e, which is chi-square with two degrees of freedom when
 //     the covariances are right: the covariance scale that makes them so, fitted by its mean
 //     (mean NEES / 2) or by its 95 % quantile (q95 / 5.991, the quantile the bounds stand on);
+//   - the scale each key pose needs to lie inside its published radius, and the one giving 95 %
+//     coverage (NEES also judges the covariance's shape; the published bound is a radius);
 //   - local coverage: for each key pose, the largest error of its position relative to a key pose
 //     within the local radius (in its own frame) against its local bound;
 //   - seed 004's claim: the mean true error of the points placed from the key poses of each level.
@@ -58,6 +60,11 @@ struct CoverageResult {
   double scale_by_mean = 0.0;                                 // nees_mean / 2
   double scale_by_q95 = 0.0;                                  // nees_q95 / 5.991
   std::vector<double> nees;                                   // per key pose (for pooling runs)
+  // Per key pose, the covariance scale at which its true error would lie exactly on its bound:
+  // (|e| / bound)^2 * published_scale (the bound grows with the square root of the scale). The
+  // share of these at or below s is the coverage the scale s would give.
+  std::vector<double> needed_scale;
+  double scale_by_coverage = 0.0;  // q95(needed_scale): the scale giving 95 % coverage
   std::vector<LevelFigure> levels;
   bool levels_increasing = false;  // mean point error strictly increasing with the level
 };
@@ -66,9 +73,10 @@ struct CoverageResult {
 std::optional<Pose2> truth_at(const std::vector<StampedTruth>& truth, int64_t utime);
 
 // Everything above for key poses sorted by id (the first one fixes the frame); `local_radius_m`
-// as the annotator's.
+// and `published_scale` (the covariance scale of the published bounds) as the annotator's.
 CoverageResult evaluate_coverage(const std::vector<KeyRecord>& keys,
-                                 const std::vector<StampedTruth>& truth, double local_radius_m);
+                                 const std::vector<StampedTruth>& truth, double local_radius_m,
+                                 double published_scale = 1.0);
 
 // The q-quantile (0..1) of values by linear interpolation; 0 for none.
 double quantile(std::vector<double> values, double q);

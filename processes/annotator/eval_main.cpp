@@ -83,11 +83,12 @@ int main(int argc, char** argv) {
 
   std::map<int64_t, KeyRecord> keys;
   std::vector<traverse::annotator::StampedTruth> truth;
-  double local_radius_m = 0.0;
+  double local_radius_m = 0.0, published_scale = 1.0;
   std::string coloured_by = "none", standard;
   std::vector<std::string> level_names;
   auto on_annotations = [&](const traverse::annotations_t& m) {
     local_radius_m = m.local_radius_m;
+    published_scale = m.covariance_scale;
     coloured_by = m.coloured_by;
     standard = m.standard;
     level_names.clear();
@@ -205,7 +206,8 @@ int main(int argc, char** argv) {
   }
   std::vector<KeyRecord> sorted;
   for (auto& [id, k] : keys) sorted.push_back(std::move(k));
-  const auto r = traverse::annotator::evaluate_coverage(sorted, truth, local_radius_m);
+  const auto r =
+      traverse::annotator::evaluate_coverage(sorted, truth, local_radius_m, published_scale);
 
   if (!o.csv.empty()) {
     std::ofstream csv(o.csv);
@@ -240,22 +242,27 @@ int main(int argc, char** argv) {
                    ", \"mean_bound_m\": " + num(f.mean_bound_m) + "}";
   }
   levels_json += "]";
-  std::string nees_json = "[";
-  for (std::size_t i = 0; i < r.nees.size(); ++i) nees_json += (i ? "," : "") + num(r.nees[i]);
-  nees_json += "]";
+  auto json_list = [](const std::vector<double>& v) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + num(v[i]);
+    return out + "]";
+  };
   std::printf(
       "{\"log\": \"%s\", \"events\": %lld, \"key_poses\": %d, \"coverage\": %s, "
       "\"local_coverage\": "
       "%s, \"local_key_poses\": %d, \"local_radius_m\": %s, \"position_rmse_m\": %s, "
       "\"mean_bound_m\": %s, \"nees_mean\": %s, \"nees_median\": %s, \"nees_q95\": %s, "
-      "\"scale_by_mean\": %s, \"scale_by_q95\": %s, \"coloured_by\": \"%s\", \"standard\": \"%s\", "
-      "\"levels\": %s, \"levels_increasing\": %s, \"nees\": %s}\n",
+      "\"scale_by_mean\": %s, \"scale_by_q95\": %s, \"scale_by_coverage\": %s, "
+      "\"covariance_scale\": %s, \"coloured_by\": \"%s\", \"standard\": \"%s\", "
+      "\"levels\": %s, \"levels_increasing\": %s, \"nees\": %s, \"needed_scale\": %s}\n",
       traverse::json_escape(o.log).c_str(), static_cast<long long>(events), r.key_poses,
       num(r.coverage).c_str(), num(r.local_coverage).c_str(), r.local_key_poses,
       num(local_radius_m).c_str(), num(r.position_rmse_m).c_str(), num(r.mean_bound_m).c_str(),
       num(r.nees_mean).c_str(), num(r.nees_median).c_str(), num(r.nees_q95).c_str(),
-      num(r.scale_by_mean).c_str(), num(r.scale_by_q95).c_str(),
-      traverse::json_escape(coloured_by).c_str(), traverse::json_escape(standard).c_str(),
-      levels_json.c_str(), r.levels_increasing ? "true" : "false", nees_json.c_str());
+      num(r.scale_by_mean).c_str(), num(r.scale_by_q95).c_str(), num(r.scale_by_coverage).c_str(),
+      num(published_scale).c_str(), traverse::json_escape(coloured_by).c_str(),
+      traverse::json_escape(standard).c_str(), levels_json.c_str(),
+      r.levels_increasing ? "true" : "false", json_list(r.nees).c_str(),
+      json_list(r.needed_scale).c_str());
   return r.key_poses > 0 ? 0 : 1;
 }

@@ -63,6 +63,12 @@ TEST(Coverage, NeesFindsTheScaleOfOverConfidentCovariances) {
   EXPECT_LT(r.coverage, 0.6);
   EXPECT_NEAR(r.scale_by_mean, 16.0, 1.5);
   EXPECT_NEAR(r.scale_by_q95, 16.0, 2.0);
+  // The scale at which 95 % lie inside the published radius: the same for Gaussian errors.
+  EXPECT_NEAR(r.scale_by_coverage, 16.0, 2.0);
+  ASSERT_EQ(r.needed_scale.size(), 3999u);
+  int inside_at_16 = 0;
+  for (double s : r.needed_scale) inside_at_16 += s <= 16.0;
+  EXPECT_NEAR(inside_at_16 / 3999.0, 0.95, 0.015);
 }
 
 TEST(Coverage, TruthInterpolatesAndLevelsReportPointErrors) {
