@@ -135,5 +135,20 @@ for name, path, fit in zip(names, files, fitted):
                  "position_rmse_m": r["position_rmse_m"], "mean_bound_m": r["mean_bound_m"],
                  "scale_for_95": r["scale_by_coverage"], "covariance_scale": r["covariance_scale"],
                  "levels": r["levels"], "levels_increasing": r["levels_increasing"]}
+# Seed 004's claim over every run: the mean true point error of each level, pooled by points.
+pooled = {}
+for name in out:
+    for l in out[name]["levels"]:
+        p = pooled.setdefault(l["level"], [0, 0.0, 0])
+        p[0] += l["points"]
+        p[1] += l["points"] * l["mean_point_error_m"]
+        p[2] += l["key_poses"]
+order = [l for l in ["LOA50", "LOA40", "LOA30", "LOA20", "LOA10"] if l in pooled] + \
+        sorted(l for l in pooled if l not in ["LOA50", "LOA40", "LOA30", "LOA20", "LOA10"])
+means = [pooled[l][1] / pooled[l][0] for l in order]
+print("all runs, mean true point error per level: " +
+      ", ".join(f"{l} {m:.4f} m ({pooled[l][2]} key poses)" for l, m in zip(order, means)) +
+      ("; strictly increasing" if all(a < b for a, b in zip(means, means[1:])) else
+       "; NOT strictly increasing"))
 print(json.dumps(out))
 PY
