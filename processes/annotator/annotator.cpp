@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "config.hpp"
+
 namespace traverse::annotator {
 namespace {
 
@@ -23,23 +25,21 @@ bool changed_by(double now, double before, double fraction) {
 
 }  // namespace
 
-std::string validate(const AnnotatorConfig& c) {
-  if (auto e = Legend::validate(c.levels, c.limits_m, c.best_level, c.worst_level); !e.empty()) {
-    return e;
+std::optional<std::string> validate(const AnnotatorConfig& c) {
+  if (auto problem = Legend::validate(c.levels, c.limits_m, c.best_level, c.worst_level)) {
+    return problem;
   }
-  if (!parse_bound_method(c.bound)) {
-    return "bound must be exact, chi2_max_eigen or paper, not '" + c.bound + "'";
-  }
-  if (c.colour_by != "absolute" && c.colour_by != "local") {
-    return "colour_by must be absolute or local, not '" + c.colour_by + "'";
-  }
-  if (c.colour_by == "local" && !(c.local_radius_m > 0.0)) {
-    return "colour_by: local needs local_radius_m > 0";
-  }
-  if (!(c.covariance_scale > 0.0)) return "covariance_scale must be > 0";
-  if (!(c.local_radius_m >= 0.0)) return "local_radius_m must be >= 0 (0: no local bound)";
-  if (!(c.republish_fraction >= 0.0)) return "republish_fraction must be >= 0";
-  return {};
+  ConfigCheck check;
+  check.require(parse_bound_method(c.bound).has_value(), "bound",
+                "must be exact, chi2_max_eigen or paper, not '" + c.bound + "'");
+  check.require(c.colour_by == "absolute" || c.colour_by == "local", "colour_by",
+                "must be absolute or local, not '" + c.colour_by + "'");
+  check.positive("covariance_scale", c.covariance_scale);
+  check.not_negative("local_radius_m", c.local_radius_m);
+  check.require(c.colour_by != "local" || c.local_radius_m > 0.0, "local_radius_m",
+                "must be positive when colour_by is local");
+  check.not_negative("republish_fraction", c.republish_fraction);
+  return check.problem();
 }
 
 Annotator::Annotator(const AnnotatorConfig& config)

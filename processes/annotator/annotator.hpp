@@ -59,8 +59,8 @@ struct AnnotatorConfig {
   }
 };
 
-// An error message when a value is out of range, empty when the config is valid.
-std::string validate(const AnnotatorConfig& config);
+// The first value out of range, named by its key; nullopt when the config is usable.
+std::optional<std::string> validate(const AnnotatorConfig& config);
 
 struct Annotation {
   int64_t id = 0;

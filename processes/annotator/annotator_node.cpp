@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "config.hpp"
+
 namespace traverse::annotator {
 namespace {
 
@@ -18,9 +20,15 @@ void set_rgb(const Rgb& rgb, uint8_t out[3]) { std::copy(rgb.begin(), rgb.end(),
 
 }  // namespace
 
-std::string validate(const AnnotatorNodeConfig& c) {
-  if (c.max_keys_per_message < 1) return "max_keys_per_message must be >= 1";
-  return validate(c.annotator);
+std::optional<std::string> validate(const AnnotatorNodeConfig& c) {
+  ConfigCheck check;
+  check.not_empty("key_poses_channel", c.key_poses_channel);
+  check.not_empty("edges_channel", c.edges_channel);
+  check.not_empty("annotations_channel", c.annotations_channel);
+  // 52 bytes per key pose: at most 1200 keep a part under 64 KB.
+  check.in_range("max_keys_per_message", c.max_keys_per_message, 1, 1200);
+  if (check.problem()) return check.problem();
+  return validate(c.annotator);  // its keys sit at the top level of the file
 }
 
 std::vector<annotations_t> pack_annotations(const Annotator& annotator,

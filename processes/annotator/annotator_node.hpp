@@ -7,6 +7,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,8 @@ struct AnnotatorNodeConfig {
   }
 };
 
-// An error message when a value is out of range, empty when the config is valid.
-std::string validate(const AnnotatorNodeConfig& config);
+// The first value out of range, named by its key; nullopt when the config is usable.
+std::optional<std::string> validate(const AnnotatorNodeConfig& config);
 
 // The messages that carry `annotations` (at most `per_message` each) with the legend; sets
 // everything but seq.

@@ -111,8 +111,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "traverse-annotator-eval: %s\n", ex.what());
       return 2;
     }
-    if (const std::string error = traverse::annotator::validate(config); !error.empty()) {
-      std::fprintf(stderr, "traverse-annotator-eval: %s: %s\n", o.recompute.c_str(), error.c_str());
+    if (const auto problem = traverse::annotator::validate(config)) {
+      std::fprintf(stderr, "traverse-annotator-eval: %s: %s\n", o.recompute.c_str(),
+                   problem->c_str());
       return 2;
     }
     bus = std::make_unique<traverse::Bus>("memq://");

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "config.hpp"
+
 namespace traverse::annotator {
 
 Rgb ramp_colour(double t) {
@@ -17,25 +19,25 @@ Rgb ramp_colour(double t) {
           static_cast<uint8_t>(std::lround(255.0 * g)), 0};
 }
 
-std::string Legend::validate(const std::vector<std::string>& names,
-                             const std::vector<double>& limits_m, const std::string& best,
-                             const std::string& worst) {
-  if (names.size() < 2) return "levels must name at least two levels";
-  if (limits_m.size() + 1 != names.size()) {
-    return "limits_m must hold one upper limit per level but the last (" +
-           std::to_string(names.size() - 1) + "), not " + std::to_string(limits_m.size());
-  }
+std::optional<std::string> Legend::validate(const std::vector<std::string>& names,
+                                            const std::vector<double>& limits_m,
+                                            const std::string& best, const std::string& worst) {
+  ConfigCheck check;
+  check.require(names.size() >= 2, "levels", "must name at least two levels");
+  check.require(limits_m.size() + 1 == names.size(), "limits_m",
+                "must hold one upper limit per level but the last (" +
+                    std::to_string(names.empty() ? 0 : names.size() - 1) + "), not " +
+                    std::to_string(limits_m.size()));
   for (std::size_t i = 0; i < limits_m.size(); ++i) {
-    if (!(limits_m[i] > (i == 0 ? 0.0 : limits_m[i - 1]))) {
-      return "limits_m must be positive and increasing";
-    }
+    check.require(limits_m[i] > (i == 0 ? 0.0 : limits_m[i - 1]), "limits_m",
+                  "must be positive and increasing");
   }
   const auto b = std::find(names.begin(), names.end(), best);
   const auto w = std::find(names.begin(), names.end(), worst);
-  if (b == names.end()) return "best_level '" + best + "' is not one of levels";
-  if (w == names.end()) return "worst_level '" + worst + "' is not one of levels";
-  if (b > w) return "best_level must not be worse than worst_level";
-  return {};
+  check.require(b != names.end(), "best_level", "'" + best + "' is not one of levels");
+  check.require(w != names.end(), "worst_level", "'" + worst + "' is not one of levels");
+  check.require(b <= w, "best_level", "must not be worse than worst_level");
+  return check.problem();
 }
 
 Legend::Legend(std::string standard, const std::vector<std::string>& names,

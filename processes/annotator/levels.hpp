@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,10 +36,11 @@ class Legend {
   Legend(std::string standard, const std::vector<std::string>& names,
          const std::vector<double>& limits_m, const std::string& best, const std::string& worst);
 
-  // An error message when the inputs of the constructor do not make a legend, else empty.
-  static std::string validate(const std::vector<std::string>& names,
-                              const std::vector<double>& limits_m, const std::string& best,
-                              const std::string& worst);
+  // The first problem of the constructor's inputs, named by its config key (levels, limits_m,
+  // best_level, worst_level); nullopt when they make a legend.
+  static std::optional<std::string> validate(const std::vector<std::string>& names,
+                                             const std::vector<double>& limits_m,
+                                             const std::string& best, const std::string& worst);
 
   // Index of the level a 95 % bound [m] falls in (a bound on a limit belongs to the better one).
   int level_of(double bound_m) const;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,7 @@ struct BackendNodeConfig {
 };
 
 // An error message when a value is out of range, empty when the config is valid.
-std::string validate(const BackendNodeConfig& config);
+std::optional<std::string> validate(const BackendNodeConfig& config);
 
 class BackendNode {
  public:

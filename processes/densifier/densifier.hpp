@@ -64,6 +64,9 @@ struct DensifierConfig {
 // "paper" or "rigid"; nullopt for anything else.
 std::optional<Mode> parse_mode(const std::string& name);
 
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const DensifierConfig& config);
+
 struct StampedPose {
   int64_t utime = 0;  // [us]
   Pose2 T_world_base;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
+#include <optional>
 #include <string>
 
 #include "bus.hpp"
@@ -13,6 +14,8 @@
 #include "stream_analyzer.hpp"
 
 namespace traverse {
+
+namespace validate {
 
 // The verdict's thresholds: a run is ok only when every figure is within them (the defaults
 // allow no loss at all; a clean run on one host loses nothing).
@@ -36,6 +39,12 @@ struct MonitorConfig {
     v("max_seq_gaps", max_seq_gaps);
   }
 };
+
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const MonitorConfig& config);
+
+}  // namespace validate
+using validate::MonitorConfig;
 
 class MonitorNode {
  public:

@@ -25,8 +25,8 @@ class AnnotatorNodeTest : public ::testing::Test {
     backend_config.max_poses_per_message = 10;  // parts for both channels
     backend_config.backend.frontend_sigma_xy_m = 0.015;
     backend_config.backend.frontend_sigma_theta_rad = 0.005;
-    ASSERT_EQ(backend::validate(backend_config), "");
-    ASSERT_EQ(validate(config), "");
+    ASSERT_FALSE(backend::validate(backend_config));
+    ASSERT_FALSE(validate(config));
     backend::BackendNode backend(bus_, backend_config);
     AnnotatorNode annotator(bus_, config,
                             [this](const std::string& k, double v) { counters_[k] = v; });

@@ -138,19 +138,19 @@ TEST(Annotator, BadAndMissingEdgesAreCounted) {
 
 TEST(Annotator, ConfigValidationNamesTheKey) {
   AnnotatorConfig c;
-  EXPECT_EQ(validate(c), "");
+  EXPECT_FALSE(validate(c));
   c.bound = "twice";
-  EXPECT_NE(validate(c).find("bound"), std::string::npos);
+  EXPECT_NE(validate(c).value_or("").find("bound"), std::string::npos);
   c = AnnotatorConfig{};
   c.colour_by = "local";
   c.local_radius_m = 0.0;
-  EXPECT_NE(validate(c).find("local_radius_m"), std::string::npos);
+  EXPECT_NE(validate(c).value_or("").find("local_radius_m"), std::string::npos);
   c = AnnotatorConfig{};
   c.covariance_scale = 0.0;
-  EXPECT_NE(validate(c).find("covariance_scale"), std::string::npos);
+  EXPECT_NE(validate(c).value_or("").find("covariance_scale"), std::string::npos);
   c = AnnotatorConfig{};
   c.worst_level = "LOA99";
-  EXPECT_NE(validate(c).find("worst_level"), std::string::npos);
+  EXPECT_NE(validate(c).value_or("").find("worst_level"), std::string::npos);
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 // Seed 004's loop closure, on the court: logs/court-loop_seed1_graph.lcmlog holds the backend's
 // and the annotator's messages of a whole court-loop run (realistic profile, seed 1; see
 // logs/README.md). After each loop closure the key poses near it must get smaller bounds and some
-// of them a better level and another colour, both in the annotations the run recorded and in those
-// the annotator computes now from the same backend messages with configs/annotator.yaml.
+// of them a better level and another colour in the annotations the run recorded (covariance scale
+// 1), and smaller bounds in those the annotator computes now from the same backend messages with
+// configs/annotator.yaml.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -67,7 +68,7 @@ struct ClosureScore {
   }
 };
 
-void expect_closures_lower_bounds(const ClosureScore& s) {
+void expect_closures_lower_bounds(const ClosureScore& s, bool expect_new_colours = true) {
   std::printf(
       "closure updates %d: key poses near a closure %d, bound lowered %d, raised %d, "
       "recoloured %d (greener %d)\n",
@@ -75,7 +76,9 @@ void expect_closures_lower_bounds(const ClosureScore& s) {
   EXPECT_GT(s.updates, 0);
   EXPECT_GT(s.near, 20);
   EXPECT_GT(s.lowered, 4 * s.raised) << "lowered " << s.lowered << ", raised " << s.raised;
-  EXPECT_GT(s.greener, 0) << "recoloured " << s.recoloured;
+  if (expect_new_colours) {
+    EXPECT_GT(s.greener, 0) << "recoloured " << s.recoloured;
+  }
 }
 
 TEST(CourtClosure, RecordedAnnotationsDropAndTurnGreenerAtClosures) {
@@ -99,10 +102,13 @@ TEST(CourtClosure, RecordedAnnotationsDropAndTurnGreenerAtClosures) {
   expect_closures_lower_bounds(score);
 }
 
-TEST(CourtClosure, AnnotatorWithTheShippedConfigDoesTheSame) {
+// With the calibrated covariance_scale the court's bounds near the closures fall from about 0.3 m
+// to about 0.1 m (the key poses' true errors are of that size), all still LOA10: the bounds must
+// drop, the colours need not change.
+TEST(CourtClosure, AnnotatorWithTheShippedConfigLowersTheBounds) {
   AnnotatorNodeConfig config;
   load_config("configs/annotator.yaml", config);
-  ASSERT_EQ(validate(config), "");
+  ASSERT_FALSE(validate(config));
   config.annotations_channel = "ANNOTATIONS_NOW";
   Bus bus("memq://");
   AnnotatorNode node(bus, config);
@@ -118,7 +124,7 @@ TEST(CourtClosure, AnnotatorWithTheShippedConfigDoesTheSame) {
     while (bus.lcm().handleTimeout(0) > 0) {
     }
   }
-  expect_closures_lower_bounds(score);
+  expect_closures_lower_bounds(score, /*expect_new_colours=*/false);
 }
 
 }  // namespace

@@ -41,15 +41,18 @@ TEST(Legend, GreenAtTheBestRedAtTheWorstHuesBetween) {
 }
 
 TEST(Legend, ValidationNamesTheProblem) {
-  EXPECT_EQ(Legend::validate(kNames, kLimits, "LOA30", "LOA10"), "");
-  EXPECT_NE(Legend::validate(kNames, {0.001, 0.005}, "LOA30", "LOA10").find("limits_m"),
-            std::string::npos);
+  EXPECT_FALSE(Legend::validate(kNames, kLimits, "LOA30", "LOA10"));
   EXPECT_NE(
-      Legend::validate(kNames, {0.001, 0.005, 0.004, 0.05}, "LOA30", "LOA10").find("increasing"),
+      Legend::validate(kNames, {0.001, 0.005}, "LOA30", "LOA10").value_or("").find("limits_m"),
       std::string::npos);
-  EXPECT_NE(Legend::validate(kNames, kLimits, "LOA31", "LOA10").find("best_level"),
+  EXPECT_NE(Legend::validate(kNames, {0.001, 0.005, 0.004, 0.05}, "LOA30", "LOA10")
+                .value_or("")
+                .find("increasing"),
             std::string::npos);
-  EXPECT_NE(Legend::validate(kNames, kLimits, "LOA10", "LOA30").find("worse"), std::string::npos);
+  EXPECT_NE(Legend::validate(kNames, kLimits, "LOA31", "LOA10").value_or("").find("best_level"),
+            std::string::npos);
+  EXPECT_NE(Legend::validate(kNames, kLimits, "LOA10", "LOA30").value_or("").find("worse"),
+            std::string::npos);
 }
 
 }  // namespace
