@@ -6,6 +6,7 @@
 #include "config.hpp"
 #include "scan_message.hpp"
 #include "traverse/key_poses_t.hpp"
+#include "traverse/pose_graph_edges_t.hpp"
 
 namespace traverse::backend {
 namespace {
@@ -24,6 +25,7 @@ std::optional<std::string> validate(const BackendNodeConfig& c) {
   check.not_empty("pose_channel", c.pose_channel);
   check.not_empty("key_poses_channel", c.key_poses_channel);
   check.not_empty("trajectory_channel", c.trajectory_channel);
+  check.not_empty("edges_channel", c.edges_channel);
   check.in_range("max_poses_per_message", c.max_poses_per_message, 1, 580);
   check.not_negative("publish_move_m", c.publish_move_m);
   check.not_negative("publish_turn_rad", c.publish_turn_rad);
@@ -80,10 +82,54 @@ bool BackendNode::changed(int i) const {
   return false;
 }
 
+// The edges appended since the last call. The graph has no edge kinds: an edge between
+// non-consecutive key poses is a loop closure, the second edge of a consecutive pair is the
+// frontend's motion (backend.cpp adds the link first).
+void BackendNode::publish_new_edges(int32_t optimisation) {
+  const std::vector<Edge>& edges = backend_.graph().edges;
+  const std::vector<KeyPose>& keys = backend_.key_poses();
+  // 125 bytes per edge: at most 500 keep a part under 64 KB.
+  const std::size_t per = static_cast<std::size_t>(std::min(config_.max_poses_per_message, 500));
+  const std::size_t first = edges_published_;
+  const int parts = static_cast<int>((edges.size() - first + per - 1) / per);
+  for (int part = 0; part < parts; ++part) {
+    pose_graph_edges_t msg{};
+    msg.utime = keys.back().utime;
+    msg.optimisation = optimisation;
+    msg.part = part;
+    msg.parts = parts;
+    msg.total_edges = static_cast<int32_t>(edges.size());
+    msg.first_index = static_cast<int32_t>(first + part * per);
+    for (std::size_t k = msg.first_index; k < std::min(edges.size(), first + (part + 1) * per);
+         ++k) {
+      const Edge& e = edges[k];
+      pose_graph_edge_t m{};
+      m.utime = keys[e.to].utime;
+      m.index = static_cast<int32_t>(k);
+      m.from_id = e.from;
+      m.to_id = e.to;
+      const bool consecutive = e.to == e.from + 1;
+      const bool repeated = k > 0 && edges[k - 1].from == e.from && edges[k - 1].to == e.to;
+      m.kind = !consecutive ? pose_graph_edge_t::KIND_LOOP_CLOSURE
+               : repeated   ? pose_graph_edge_t::KIND_FRONTEND
+                            : pose_graph_edge_t::KIND_LINK;
+      m.x = e.T_from_to.x();
+      m.y = e.T_from_to.y();
+      m.theta = e.T_from_to.theta();
+      copy_matrix(e.information, m.information);
+      msg.edges.push_back(m);
+    }
+    msg.n_edges = static_cast<int32_t>(msg.edges.size());
+    bus_.publish(config_.edges_channel, msg);
+  }
+  edges_published_ = edges.size();
+}
+
 void BackendNode::publish(const BackendUpdate& update) {
   const std::vector<KeyPose>& keys = backend_.key_poses();
   const PoseGraph& graph = backend_.graph();
   if (keys.empty()) return;
+  publish_new_edges(update.optimisation);
   std::vector<int> changed_ids;
   for (int i = 0; i < static_cast<int>(keys.size()); ++i) {
     if (changed(i)) changed_ids.push_back(i);

@@ -1,7 +1,9 @@
 // Adapts LCM messages to the backend: planar_scan_t (horizontal scanner) and the frontend's
 // pose2d_t in; after each optimisation, key_poses_t on KEY_POSES with only the key poses that
 // appeared, moved or whose marginal covariance changed (split into parts that each fit one UDP
-// datagram), and each new key pose once as pose2d_t (FLAG_KEY_POSE) on POSE_BACKEND.
+// datagram), and each new key pose once as pose2d_t (FLAG_KEY_POSE) on POSE_BACKEND. Just before
+// each KEY_POSES update, the pose-graph edges added since the previous one on POSE_GRAPH_EDGES
+// (pose_graph_edges_t, in parts of at most max_poses_per_message edges).
 #pragma once
 
 #include <functional>
@@ -24,6 +26,7 @@ struct BackendNodeConfig {
   std::string odometry_channel = channels::kOdometry;  // odometry_t; empty: none
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
+  std::string edges_channel = channels::kPoseGraphEdges;
   int max_poses_per_message = 400;          // 112 bytes each: 400 keep a part under 64 KB
   double publish_move_m = 0.001;            // a key pose moved farther than this is republished [m]
   double publish_turn_rad = 0.0005;         // ... or turned more than this [rad]
@@ -37,6 +40,7 @@ struct BackendNodeConfig {
     v("odometry_channel", odometry_channel);
     v("key_poses_channel", key_poses_channel);
     v("trajectory_channel", trajectory_channel);
+    v("edges_channel", edges_channel);
     v("max_poses_per_message", max_poses_per_message);
     v("publish_move_m", publish_move_m);
     v("publish_turn_rad", publish_turn_rad);
@@ -69,6 +73,7 @@ class BackendNode {
   void on_pose(const pose2d_t& msg);
   void on_odometry(const odometry_t& msg);
   void publish(const BackendUpdate& update);
+  void publish_new_edges(int32_t optimisation);
   bool changed(int index) const;
 
   Bus& bus_;
@@ -82,6 +87,7 @@ class BackendNode {
   std::vector<Published> published_;
   std::size_t max_message_bytes_ = 0;
   long messages_ = 0;
+  std::size_t edges_published_ = 0;
 };
 
 }  // namespace traverse::backend
