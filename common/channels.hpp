@@ -15,6 +15,10 @@ inline const std::string kPoseGroundTruth3d =
 inline const std::string kPoseReference = "POSE_REFERENCE";  // pose2d_t, external reference
 inline const std::string kPoseFrontend = "POSE_FRONTEND";    // pose2d_t, one per scan
 inline const std::string kKeyPoses = "KEY_POSES";  // key_poses_t, backend key poses (incremental)
+inline const std::string kPoseGraphEdges =
+    "POSE_GRAPH_EDGES";  // pose_graph_edges_t, backend graph edges (appended)
+inline const std::string kAnnotations =
+    "ANNOTATIONS";  // annotations_t, 95 % bounds, accuracy levels, colours
 inline const std::string kPoseBackend = "POSE_BACKEND";      // pose2d_t, each backend key pose once
 inline const std::string kPoseDense = "POSE_DENSE";          // pose2d_t, corrected dense trajectory
 inline const std::string kDenseSegments = "DENSE_SEGMENTS";  // dense_segments_t, new or moved

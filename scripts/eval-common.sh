@@ -40,7 +40,7 @@ estimate_channel() {
   local last="${1##*,}"
   case "$last" in
     frontend) echo POSE_FRONTEND ;;
-    backend) echo KEY_POSES ;;
+    backend | annotator) echo KEY_POSES ;;
     densifier | mapper | all) echo DENSE_SEGMENTS ;;
     *) die "stage '$last' publishes no trajectory this script knows (add it to estimate_channel)" ;;
   esac
@@ -138,7 +138,8 @@ check_stage_poses() {
   python3 - "$stages" "$counts" <<'PY' || die "a stage published too little (see above)"
 import json, sys
 stages, counts = sys.argv[1].split(","), json.loads(sys.argv[2])["channels"]
-channels = {"frontend": "POSE_FRONTEND", "backend": "POSE_BACKEND", "densifier": "POSE_DENSE"}
+channels = {"frontend": "POSE_FRONTEND", "backend": "POSE_BACKEND", "densifier": "POSE_DENSE",
+            "annotator": "ANNOTATIONS"}
 bad = [(s, channels[s], counts.get(channels[s], {}).get("count", 0)) for s in stages
        if s in channels and counts.get(channels[s], {}).get("count", 0) < 2]
 for stage, channel, n in bad:

@@ -1,11 +1,13 @@
 #include "backend.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 
 #include "config.hpp"
+#include "frontend_chain.hpp"
 
 namespace traverse::backend {
 namespace {
@@ -30,7 +32,12 @@ std::optional<std::string> validate(const BackendConfig& c) {
   check.positive("fallback_sigma_theta_rad", c.fallback_sigma_theta_rad);
   check.not_negative("frontend_sigma_xy_m", c.frontend_sigma_xy_m);
   check.not_negative("frontend_sigma_theta_rad", c.frontend_sigma_theta_rad);
+  check.positive("link_covariance_scale", c.link_covariance_scale);
+  check.positive("frontend_covariance_scale", c.frontend_covariance_scale);
+  check.not_negative("frontend_drift_length_m", c.frontend_drift_length_m);
+  check.nested("odometry", validate(c.odometry));
   check.nested("loop", validate(c.loop));
+  check.not_negative("closure_max_chi2_increase", c.closure_max_chi2_increase);
   check.nested("spa", validate(c.spa));
   check.positive("optimize_every", c.optimize_every);
   check.positive("max_pending_scans", c.max_pending_scans);
@@ -39,11 +46,16 @@ std::optional<std::string> validate(const BackendConfig& c) {
 
 Backend::Backend(BackendConfig config)
     : config_(std::move(config)),
+      drift_model_(config_.frontend_drift_length_m > 0.0 && config_.frontend_sigma_xy_m > 0.0 &&
+                   config_.frontend_sigma_theta_rad > 0.0),
       T_base_laser_(config_.T_base_laser.pose()),
       link_matcher_(config_.link),
       link_refiner_(config_.link_refine),
       loop_(config_.loop),
-      spa_(config_.spa) {}
+      odometry_(config_.odometry),
+      spa_(config_.spa),
+      trial_spa_(config_.spa),
+      prep_(config_.smoothing) {}
 
 void Backend::add_scan(PlanarScan scan) {
   ++counters_.scans;
@@ -53,64 +65,25 @@ void Backend::add_scan(PlanarScan scan) {
   }
 }
 
-Pose2 Backend::smooth(int64_t utime, const Pose2& T_map_base) {
-  if (tail_.empty()) {
-    last_raw_ = T_map_base;
-    tail_.push_back({utime, T_map_base});
-    return T_map_base;
-  }
-  // The smoothing compares the newest raw step with the preceding (already smoothed) steps.
-  std::vector<StampedPose> window = tail_;
-  window.push_back({utime, tail_.back().T_world_base * between(last_raw_, T_map_base)});
-  const SmoothedTrajectory s = smooth_jumps(window, config_.smoothing);
-  const int n = static_cast<int>(s.poses.size());
-  if (!s.replaced_steps.empty() && s.replaced_steps.back() == n - 1) ++counters_.jumps_smoothed;
-  const Pose2 smoothed =
-      tail_.back().T_world_base * between(s.poses[n - 2].T_world_base, s.poses[n - 1].T_world_base);
-  last_raw_ = T_map_base;
-  tail_.push_back({utime, smoothed});
-  if (static_cast<int>(tail_.size()) > config_.smoothing.window + 1) tail_.erase(tail_.begin());
-  travel_m_ += (smoothed.translation() - tail_[tail_.size() - 2].T_world_base.translation()).norm();
-  return smoothed;
+std::optional<BackendUpdate> Backend::add_pose(int64_t utime, const Pose2& T_map_base,
+                                               const Eigen::Matrix3d& covariance) {
+  const std::optional<PreparedPose> pose = prep_.add({utime, T_map_base, covariance});
+  counters_.prep = prep_.counters();
+  if (!pose) return std::nullopt;
+  return take_pose(*pose);
 }
 
-bool Backend::is_outlier(const StampedPose& held, const StampedPose& next) const {
-  if (tail_.empty()) return false;
-  // The two raw steps appended to the smoothed tail, as smooth() would append them.
-  std::vector<StampedPose> window = tail_;
-  window.push_back({held.utime, tail_.back().T_world_base * between(last_raw_, held.T_world_base)});
-  window.push_back({next.utime, tail_.back().T_world_base * between(last_raw_, next.T_world_base)});
-  const SmoothedTrajectory s = smooth_jumps(std::move(window), config_.smoothing);
-  return !s.outliers.empty() && s.outliers.back() == static_cast<int>(tail_.size());
-}
-
-std::optional<BackendUpdate> Backend::add_pose(int64_t utime, const Pose2& T_map_base) {
-  ++counters_.poses;
-  const StampedPose next{utime, T_map_base};
-  if (!held_) {
-    held_ = next;
-    return std::nullopt;
-  }
-  StampedPose pose = *held_;
-  held_ = next;
-  if (is_outlier(pose, next)) {
-    ++counters_.outliers_replaced;
-    const double s = static_cast<double>(pose.utime - last_key_input_utime_) /
-                     static_cast<double>(std::max<int64_t>(1, next.utime - last_key_input_utime_));
-    pose.T_world_base = interpolate(last_raw_, next.T_world_base, s);
-  }
-  return take_pose(pose.utime, pose.T_world_base);
-}
-
-std::optional<BackendUpdate> Backend::take_pose(int64_t utime, const Pose2& T_map_base) {
-  last_key_input_utime_ = utime;
-  const Pose2 smoothed = smooth(utime, T_map_base);
-  since_key_.push_back({utime, smoothed});
+std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
+  if (!since_key_.empty()) previous_ = since_key_.back();
+  since_key_.push_back(pose);
   const bool first = key_poses_.empty() && since_key_.size() == 1;
-  const std::vector<int> keys = select_key_poses(since_key_, config_.key_poses);
+  std::vector<StampedPose> since;
+  for (const PreparedPose& p : since_key_) since.push_back({p.utime, p.T_world_base});
+  const std::vector<int> keys = select_key_poses(since, config_.key_poses);
   if (!first && keys.back() != static_cast<int>(since_key_.size()) - 1) return std::nullopt;
 
   // The scan this pose belongs to: the one ending at the pose's time (older ones are dropped).
+  const int64_t utime = pose.utime;
   while (!pending_scans_.empty() && pending_scans_.front().utime_last < utime) {
     pending_scans_.pop_front();
   }
@@ -127,89 +100,189 @@ std::optional<BackendUpdate> Backend::take_pose(int64_t utime, const Pose2& T_ma
   for (std::size_t i = 0; i < travel.size(); ++i) travel[i] = key_poses_[i].travel_m;
   std::vector<Eigen::Matrix3d> marginals(key_poses_.size());
   for (std::size_t i = 0; i < marginals.size(); ++i) marginals[i] = key_poses_[i].covariance;
-  const std::optional<LoopClosure> closure =
-      loop_.add(current, graph_.poses, travel, scans_, &marginals);
+  std::vector<Pose2> poses(key_poses_.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) poses[i] = key_poses_[i].T_world_base;
+  const std::optional<LoopClosure> closure = loop_.add(current, poses, travel, scans_, &marginals);
   if (closure) add_closure(*closure);
   if (closure || current % config_.optimize_every == 0) return optimise();
   return std::nullopt;
 }
 
+std::pair<Eigen::Matrix3d, Eigen::Matrix3d> Backend::frontend_covariances() const {
+  const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
+  const Eigen::Matrix3d fixed = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
+  const double scale = config_.frontend_covariance ? config_.frontend_covariance_scale : 0.0;
+  const auto covariance = [&](const PreparedPose& p) {
+    return scale > 0.0 ? frontend_pose_covariance(p, scale, fixed) : fixed;
+  };
+  const PreparedPose& a = last_key_;
+  const PreparedPose& b = since_key_.back();
+  const Eigen::Matrix3d cb = covariance(b);
+  // The frontend's first pose defines its map and carries no covariance: it takes its
+  // neighbour's.
+  if (scale > 0.0 && a.frontend.covariance.isZero()) return {cb, cb};
+  return {covariance(a), cb};
+}
+
+void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odometry) {
+  const PreparedPose& a = last_key_;
+  const PreparedPose& b = since_key_.back();
+  const auto [ca, cb] = frontend_covariances();
+  const int from = drift_model_ ? key_vertex(key - 1) + 1 : key_vertex(key - 1);
+  const int to = drift_model_ ? key_vertex(key) + 1 : key_vertex(key);
+  if (odometry) {  // the odometry's step instead of the frontend's
+    Edge edge;
+    edge.from = from;
+    edge.to = to;
+    edge.T_from_to = odometry->motion;
+    edge.information = odometry->covariance.inverse();
+    graph_.edges.push_back(edge);
+    edge_kinds_.push_back(drift_model_ ? EdgeKind::kFrontendDrift : EdgeKind::kFrontend);
+  } else if (!drift_model_) {
+    graph_.edges.push_back(motion_edge(from, to, a, b, ca, cb));
+    edge_kinds_.push_back(EdgeKind::kFrontend);
+  } else {
+    graph_.edges.push_back(drift_edge(from, to, a, b, ca, cb, config_.frontend_drift_length_m));
+    edge_kinds_.push_back(EdgeKind::kFrontendDrift);
+  }
+  if (!drift_model_) return;
+  const int m_b = to;
+  Edge pose;
+  pose.from = m_b;
+  pose.to = key_vertex(key);
+  pose.information = cb.inverse();
+  graph_.edges.push_back(pose);
+  edge_kinds_.push_back(EdgeKind::kFrontendPose);
+}
+
 void Backend::add_key_pose(const PlanarScan& scan) {
-  const StampedPose& now = tail_.back();
-  // Motion during the sweep, relative to the key pose: the last smoothed step, at constant
-  // velocity (the frontend publishes one pose per sweep).
+  const PreparedPose& now = since_key_.back();
+  // Motion during the sweep, relative to the key pose: the last prepared step, at constant
+  // velocity (the frontend publishes one pose per sweep), unless the poses come seconds apart
+  // (a log subsampled by travel: the step says nothing about the motion during one sweep).
   Eigen::Vector3d rate = Eigen::Vector3d::Zero();  // tangent per microsecond
-  if (tail_.size() >= 2) {
-    const StampedPose& prev = tail_[tail_.size() - 2];
-    const double dt = static_cast<double>(std::max<int64_t>(1, now.utime - prev.utime));
-    rate = between(prev.T_world_base, now.T_world_base).log() / dt;
+  if (previous_ && !now.sparse) {
+    const double dt = static_cast<double>(std::max<int64_t>(1, now.utime - previous_->utime));
+    rate = between(previous_->T_world_base, now.T_world_base).log() / dt;
   }
   const auto T_ref_base = [&](int64_t t) {
     return Pose2::exp(rate * static_cast<double>(t - now.utime));
   };
-  const int index = scans_.add(reduce_scan(scan, T_base_laser_, T_ref_base, config_.scans));
+  // The scan store and the graph are changed only at the end, together, so that they stay in
+  // step even if anything before throws.
+  std::vector<Eigen::Vector2f> points = reduce_scan(scan, T_base_laser_, T_ref_base, config_.scans);
+  const int index = scans_.size();
 
   KeyPose key;
   key.utime = now.utime;
-  key.travel_m = travel_m_;
+  key.travel_m = now.travel_m;
+  const bool frontend = config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
   if (index == 0) {
-    graph_.add_vertex(index, now.T_world_base, true);
+    key.T_world_base = now.T_world_base;
+    graph_.add_vertex(key_vertex(0), now.T_world_base, true);
+    // The drifting frontend starts where the key poses do: both are fixed there.
+    if (drift_model_) graph_.add_vertex(key_vertex(0) + 1, now.T_world_base, true);
   } else {
     // Link to the previous key pose: match against the last few key scans around the frontend's
     // relative motion.
     const int prev = index - 1;
-    const Pose2 T_world_guess = graph_.poses[prev] * between(last_key_smoothed_, now.T_world_base);
+    Pose2 motion = between(last_key_.T_world_base, now.T_world_base);
     std::vector<Eigen::Vector2d> reference;
     for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
-      scans_.append_world(j, graph_.poses[j], reference);
+      scans_.append_world(j, key_poses_[j].T_world_base, reference);
     }
-    const MatchResult m = link_matcher_.match(reference, scans_.points_d(index), T_world_guess);
-    Pose2 T_world_key = T_world_guess;
-    Eigen::Matrix3d covariance;
+    std::vector<Eigen::Vector2d> query(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) query[i] = points[i].cast<double>();
+    MatchResult m = link_matcher_.match(reference, query, key_poses_[prev].T_world_base * motion);
+    // A frontend step the odometry contradicts: the scans decide. The link is matched around the
+    // odometry's step too, and the odometry's step replaces the frontend's only if the scans
+    // agree with it better (an odometry that slips or a log's restarted odometry must not
+    // replace a good frontend step).
+    std::optional<OdometryStep> odometry;
+    if (frontend) {
+      const auto [ca, cb] = frontend_covariances();
+      odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
+      if (odometry && odometry->frontend_rejected) {
+        const MatchResult mo =
+            link_matcher_.match(reference, query, key_poses_[prev].T_world_base * odometry->motion);
+        if (mo.valid && (!m.valid || mo.raw_response > m.raw_response)) {
+          m = mo;
+          motion = odometry->motion;
+          ++counters_.frontend_steps_replaced;
+        } else {
+          odometry.reset();
+        }
+      } else {
+        odometry.reset();
+      }
+    }
+    Edge link;
+    link.from = key_vertex(prev);
+    link.to = key_vertex(index);
+    bool linked = false;
     if (m.valid && m.raw_response >= config_.min_link_response) {
-      ++counters_.links_matched;
-      T_world_key = m.T_world_query;
+      Pose2 T_world_key = m.T_world_query;
       if (config_.link_refine.enabled) {
-        const RefineResult r = link_refiner_.refine(reference, scans_.points_d(index), T_world_key);
+        const RefineResult r = link_refiner_.refine(reference, query, T_world_key);
         if (r.valid) {
           ++counters_.links_refined;
           T_world_key = r.T_world_query;
         }
       }
-      // The matcher's covariance is in the world frame; the edge error's in the key pose's.
-      covariance = rotate_covariance(m.covariance, T_world_key.rotation().transpose());
-    } else {
+      link.T_from_to = between(key_poses_[prev].T_world_base, T_world_key);
+      link.information = (config_.link_covariance_scale *
+                          rotate_covariance(m.covariance, T_world_key.rotation().transpose()))
+                             .inverse();
+      linked = true;
+      ++counters_.links_matched;
+    } else if (!frontend) {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;
-      covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-    }
-    graph_.add_vertex(index, T_world_key);
-    Edge edge;
-    edge.from = prev;
-    edge.to = index;
-    edge.T_from_to = between(graph_.poses[prev], T_world_key);
-    edge.information = covariance.inverse();
-    graph_.edges.push_back(edge);
-    if (config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0) {
-      const double sxy = config_.frontend_sigma_xy_m, sth = config_.frontend_sigma_theta_rad;
-      edge.T_from_to = between(last_key_smoothed_, now.T_world_base);
-      edge.information =
+      link.T_from_to = motion;
+      link.information =
           Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (sth * sth)).asDiagonal();
-      graph_.edges.push_back(edge);
+      linked = true;
     }
+    key.T_world_base = key_poses_[prev].T_world_base * (linked ? link.T_from_to : motion);
+    graph_.add_vertex(key_vertex(index), key.T_world_base);
+    if (drift_model_) {
+      graph_.add_vertex(key_vertex(index) + 1, graph_.poses[key_vertex(prev) + 1] * motion);
+    }
+    if (linked) {
+      graph_.edges.push_back(link);
+      edge_kinds_.push_back(EdgeKind::kLink);
+    }
+    if (frontend) add_frontend_edges(index, odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
   }
+  scans_.add(std::move(points));
   key_poses_.push_back(key);
-  last_key_smoothed_ = now.T_world_base;
+  last_key_ = now;
 }
 
-void Backend::add_closure(const LoopClosure& closure) {
+void Backend::add_closure(LoopClosure closure) {
   Edge edge;
-  edge.from = closure.from;
-  edge.to = closure.to;
+  edge.from = key_vertex(closure.from);
+  edge.to = key_vertex(closure.to);
   edge.T_from_to = closure.T_from_to;
   edge.information = closure.covariance.inverse();
-  graph_.edges.push_back(edge);
+  if (config_.closure_max_chi2_increase > 0.0) {
+    // The graph at its optimum without the closure, and a copy with it: the growth of chi2 is
+    // the closure's disagreement with everything else, weighed by both covariances.
+    const SpaResult without = spa_.optimize(graph_);
+    PoseGraph trial = graph_;
+    trial.edges.push_back(edge);
+    const SpaResult with = trial_spa_.optimize(trial);
+    closure.chi2_increase = with.final_chi2 - without.final_chi2;
+    if (!(closure.chi2_increase <= config_.closure_max_chi2_increase)) {
+      ++counters_.closures_rejected_inconsistent;
+      return;
+    }
+    graph_ = std::move(trial);
+  } else {
+    graph_.edges.push_back(edge);
+  }
+  edge_kinds_.push_back(EdgeKind::kClosure);
   closures_.push_back(closure);
 }
 
@@ -221,8 +294,9 @@ std::optional<BackendUpdate> Backend::optimise() {
   const auto t1 = std::chrono::steady_clock::now();
   const auto marginals = spa_.marginals(graph_);
   update.marginals_s = seconds_since(t1);
-  if (marginals) {
-    for (std::size_t i = 0; i < key_poses_.size(); ++i) key_poses_[i].covariance = (*marginals)[i];
+  for (int i = 0; i < static_cast<int>(key_poses_.size()); ++i) {
+    key_poses_[i].T_world_base = graph_.poses[key_vertex(i)];
+    if (marginals) key_poses_[i].covariance = (*marginals)[key_vertex(i)];
   }
   ++counters_.optimisations;
   // A graph of the fixed first key pose alone has nothing to optimise.
@@ -242,13 +316,19 @@ std::optional<BackendUpdate> Backend::optimise() {
   return update;
 }
 
+std::string Backend::input_fault() const {
+  const long poses = counters_.prep.poses, dropped = counters_.prep.out_of_order;
+  if (poses < 2) return {};
+  const std::size_t keys = key_poses_.size();
+  if (keys >= 2 && 2 * dropped <= poses) return {};
+  return std::to_string(dropped) + " of " + std::to_string(poses) +
+         " frontend poses were not later than the pose before (stamps that carry no time?), " +
+         std::to_string(keys) + " key pose" + (keys == 1 ? "" : "s") + ": no trajectory";
+}
+
 std::optional<BackendUpdate> Backend::finish() {
   std::optional<BackendUpdate> last;
-  if (held_) {
-    const StampedPose pose = *held_;
-    held_.reset();
-    last = take_pose(pose.utime, pose.T_world_base);
-  }
+  if (const std::optional<PreparedPose> pose = prep_.finish()) last = take_pose(*pose);
   const std::optional<LoopClosure> closure = loop_.finish();
   if (closure) add_closure(*closure);
   if (key_poses_.empty()) return std::nullopt;

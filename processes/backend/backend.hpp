@@ -1,27 +1,31 @@
 // The backend of seed 000 (Karto's mapper and SPA, fed by Hector's trajectory) with the marginal
 // covariances of seed 004, as one algorithm without messaging:
-//   1. the frontend's dense poses are smoothed: the jumps it makes when it recovers at a loop are
-//      replaced by the average of the preceding steps (trajectory_prep.hpp);
+//   1. the frontend's poses are prepared for the input they come from: a scanner's stream has its
+//      jumps at loops smoothed away, a log subsampled by travel is taken as it is
+//      (trajectory_prep.hpp);
 //   2. key poses are picked from them (about three per second, or by distance and angle), and
 //      their scans are kept at reduced density (scan_store.hpp);
-//   3. each new key pose is linked to the previous one by correlative matching (Olson 2009) of its
-//      scan against the last few key scans, searched around the frontend's relative motion with a
-//      penalty for straying from it (correlative_matcher.hpp);
+//   3. each new key pose is linked to the previous one by the frontend's relative motion, with
+//      the covariance the frontend published for both poses, and by correlative matching (Olson
+//      2009) of its scan against the last few key scans, searched around the frontend's relative
+//      motion with a penalty for straying from it (correlative_matcher.hpp);
 //   4. loops are closed with the best of all nearby current scans (loop_closer.hpp);
 //   5. the pose graph is optimised by Sparse Pose Adjustment (spa.hpp) and the marginal
 //      covariance of every key pose is recovered from its sparse Cholesky factor.
 // Frontend poses are T_map_base (the frontend's map frame); key poses are T_world_base in the
-// backend's frame, which starts equal to the smoothed frontend frame (first key pose fixed).
+// backend's frame, which starts equal to the prepared frontend frame (first key pose fixed).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "correlative_matcher.hpp"
 #include "loop_closer.hpp"
+#include "odometry_check.hpp"
 #include "pose_config.hpp"
 #include "pose_graph.hpp"
 #include "scan_store.hpp"
@@ -52,8 +56,12 @@ struct BackendConfig {
                                 .max_query_points = 400};
   // ... then refined point to line (scan_refiner.hpp); the link keeps the correlative covariance.
   RefinerConfig link_refine;
-  int link_chain_length = 5;               // previous key scans a new key scan is matched against
-  double min_link_response = 0.35;         // below: the frontend's relative motion is used instead
+  int link_chain_length = 5;  // previous key scans a new key scan is matched against
+  // Below this response no link edge; without a frontend edge the frontend's relative motion
+  // stands in, with the fallback sigmas.
+  double min_link_response = 0.35;
+  // The match's covariance (the spread of its response surface) times this [unitless].
+  double link_covariance_scale = 1.0;
   double fallback_sigma_xy_m = 0.05;       // its standard deviation [m]
   double fallback_sigma_theta_rad = 0.02;  // [rad]
   // The frontend's relative motion between consecutive key poses as a second edge beside the
@@ -69,7 +77,23 @@ struct BackendConfig {
   // alone (offline, seed 1).
   double frontend_sigma_xy_m = 0.003;        // [m]
   double frontend_sigma_theta_rad = 0.0005;  // [rad]
+  // How the frontend's trajectory enters the graph (frontend_chain.hpp): each key pose's error
+  // is the covariance the frontend published for it (times frontend_covariance_scale; the fixed
+  // sigmas above stand in for a pose published without one, or for all with
+  // frontend_covariance false), and the frontend's map drifts by as much as one such error over
+  // frontend_drift_length_m of travel (a random walk). 0: no drift model, the frontend's motion
+  // between consecutive key poses is an edge with both poses' covariances.
+  bool frontend_covariance = true;
+  double frontend_covariance_scale = 1.0;  // [unitless]
+  double frontend_drift_length_m = 0.0;    // [m]
+  // Wheel odometry, when there is any, as a check on each frontend step (odometry_check.hpp).
+  OdometryCheckConfig odometry;
   LoopCloserConfig loop;
+  // A closure is added to a copy of the graph and both are optimised: if the graph's chi2 grows
+  // by more than this, the closure contradicts the graph and is left out (0: not checked). For a
+  // closure that agrees with the graph, the growth follows a chi-square law with 3 degrees of
+  // freedom (99.9 %: 16.3).
+  double closure_max_chi2_increase = 0.0;
   SpaConfig spa;
   int optimize_every = 1;       // key poses between optimisations (always at a closure)
   int max_pending_scans = 500;  // scans kept while waiting for their pose (~35 KB each)
@@ -84,11 +108,17 @@ struct BackendConfig {
     v("link_refine", link_refine);
     v("link_chain_length", link_chain_length);
     v("min_link_response", min_link_response);
+    v("link_covariance_scale", link_covariance_scale);
     v("fallback_sigma_xy_m", fallback_sigma_xy_m);
     v("fallback_sigma_theta_rad", fallback_sigma_theta_rad);
     v("frontend_sigma_xy_m", frontend_sigma_xy_m);
     v("frontend_sigma_theta_rad", frontend_sigma_theta_rad);
+    v("frontend_covariance", frontend_covariance);
+    v("frontend_covariance_scale", frontend_covariance_scale);
+    v("frontend_drift_length_m", frontend_drift_length_m);
+    v("odometry", odometry);
     v("loop", loop);
+    v("closure_max_chi2_increase", closure_max_chi2_increase);
     v("spa", spa);
     v("optimize_every", optimize_every);
     v("max_pending_scans", max_pending_scans);
@@ -100,10 +130,20 @@ std::optional<std::string> validate(const BackendConfig& config);
 
 struct KeyPose {
   int64_t utime = 0;      // [us] time of the frontend pose (its scan's last point)
+  Pose2 T_world_base;     // the estimate of the last optimisation (or the first guess)
   double travel_m = 0.0;  // [m] distance along the smoothed trajectory
   // Marginal covariance of (x [m], y [m], theta [rad]) in the world frame: m^2, m rad, rad^2.
   // Zero for the first key pose (it fixes the gauge).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+// What an edge of the backend's graph measures.
+enum class EdgeKind {
+  kLink,           // correlative match of a key scan against the last few (or its fallback)
+  kFrontend,       // the frontend's relative motion between consecutive key poses
+  kFrontendDrift,  // ... between consecutive poses of the drifting frontend (frontend_chain.hpp)
+  kFrontendPose,   // a key pose against the drifting frontend's pose (frontend_chain.hpp)
+  kClosure,        // a loop closure
 };
 
 struct BackendUpdate {
@@ -116,14 +156,16 @@ struct BackendUpdate {
 };
 
 struct BackendCounters {
-  long poses = 0;                   // frontend poses received
-  long jumps_smoothed = 0;          // frontend steps replaced by the average
-  long outliers_replaced = 0;       // single frontend poses replaced by their neighbours' average
+  TrajectoryPrepCounters prep;      // frontend poses received, dropped, smoothed
   long scans = 0;                   // scans received
   long key_poses_without_scan = 0;  // key pose deferred: its scan was missing
   long links_matched = 0;           // consecutive links from correlative matching
   long links_refined = 0;           // ... of which refined point to line
   long links_fallback = 0;          // ... from the frontend's motion (response too low)
+  // Frontend steps the odometry contradicted and the scans matched better at the odometry's
+  // (odometry_check.hpp): replaced by the odometry's.
+  long frontend_steps_replaced = 0;
+  long closures_rejected_inconsistent = 0;  // closures the trial optimisation refused
   long optimisations = 0;
   long optimisations_failed = 0;      // not converged or covariance not recovered
   double last_optimisation_s = 0.0;   // [s]
@@ -137,51 +179,76 @@ class Backend {
 
   // A scan of the horizontal scanner (before its frontend pose arrives).
   void add_scan(PlanarScan scan);
+  // A wheel odometry reading: the base in the drifting odom frame (before the frontend poses of
+  // its time arrive).
+  void add_odometry(int64_t utime, const Pose2& T_odom_base) { odometry_.add(utime, T_odom_base); }
   // The frontend pose of the scan ending at `utime`; returns an update when the graph was
   // optimised. Each pose is taken in when the next one arrives (or at finish()): only then can it
   // be told apart from an outlier.
-  std::optional<BackendUpdate> add_pose(int64_t utime, const Pose2& T_map_base);
+  // `covariance`: the frontend's, of (x [m], y [m], theta [rad]) in its map frame (zero: unknown).
+  std::optional<BackendUpdate> add_pose(
+      int64_t utime, const Pose2& T_map_base,
+      const Eigen::Matrix3d& covariance = Eigen::Matrix3d::Zero());
   // End of data: closes an open loop-closure episode and optimises if anything is new.
   std::optional<BackendUpdate> finish();
 
+  // The pose graph: besides the key poses (vertex key_vertex(i) for key pose i) it may hold the
+  // drifting frontend's poses (frontend_chain.hpp).
   const PoseGraph& graph() const { return graph_; }
+  int key_vertex(int key) const { return drift_model_ ? 2 * key : key; }
+  // The key pose of a vertex, -1 for the drifting frontend's.
+  int key_of_vertex(int vertex) const {
+    return drift_model_ ? (vertex % 2 == 0 ? vertex / 2 : -1) : vertex;
+  }
+  // The kind of each edge of graph().edges, in the same order.
+  const std::vector<EdgeKind>& edge_kinds() const { return edge_kinds_; }
   const std::vector<KeyPose>& key_poses() const { return key_poses_; }
   const ScanStore& scans() const { return scans_; }
   const std::vector<LoopClosure>& closures() const { return closures_; }
   const LoopCloserCounters& loop_counters() const { return loop_.counters(); }
+  const OdometryCounters& odometry_counters() const { return odometry_.counters(); }
   const BackendCounters& counters() const { return counters_; }
+  // Why the frontend's poses gave no trajectory, in words; empty when they did. Stamps that carry
+  // no time (all equal, or mostly not later than the pose before) leave one key pose of many
+  // poses: that is a failure to report, not a one-pose result.
+  std::string input_fault() const;
   int analyses() const { return spa_.system().analyses(); }
   int orderings_reused() const { return spa_.system().orderings_reused(); }
 
  private:
-  Pose2 smooth(int64_t utime, const Pose2& T_map_base);
-  // Whether the held pose is an outlier that `next` returns from (see smooth_jumps).
-  bool is_outlier(const StampedPose& held, const StampedPose& next) const;
-  std::optional<BackendUpdate> take_pose(int64_t utime, const Pose2& T_map_base);
-  // Adds the key pose at the newest smoothed pose with the points of `scan`.
+  std::optional<BackendUpdate> take_pose(const PreparedPose& pose);
+  // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
-  void add_closure(const LoopClosure& closure);
+  // The frontend's covariances of the last key pose and the newest prepared pose, each in its own
+  // frame (frontend_chain.hpp).
+  std::pair<Eigen::Matrix3d, Eigen::Matrix3d> frontend_covariances() const;
+  // Adds the frontend's edges of the new key pose `key` (frontend_chain.hpp); `odometry`: the
+  // odometry's step when it rejected the frontend's, which then takes its place.
+  void add_frontend_edges(int key, const std::optional<OdometryStep>& odometry);
+  // Adds the closure unless a trial optimisation finds it inconsistent with the graph.
+  void add_closure(LoopClosure closure);
   std::optional<BackendUpdate> optimise();
 
   BackendConfig config_;
+  bool drift_model_;  // the frontend's edges follow the drift model (frontend_chain.hpp)
   Pose2 T_base_laser_;
   CorrelativeMatcher link_matcher_;
   ScanRefiner link_refiner_;
   LoopCloser loop_;
+  OdometryCheck odometry_;
   SpaOptimizer spa_;
+  SpaOptimizer trial_spa_;  // for the graph with a closure on trial
   BackendCounters counters_;
 
+  TrajectoryPrep prep_;
   std::deque<PlanarScan> pending_scans_;
-  std::optional<StampedPose> held_;     // the newest frontend pose, not yet taken in
-  int64_t last_key_input_utime_ = 0;    // [us] time of the last pose taken in
-  std::vector<StampedPose> tail_;       // the last smoothed poses (window + 1)
-  Pose2 last_raw_;                      // the previous frontend pose
-  std::vector<StampedPose> since_key_;  // smoothed poses since the last key pose (inclusive)
-  double travel_m_ = 0.0;
+  std::optional<PreparedPose> previous_;  // the prepared pose before the newest
+  std::vector<PreparedPose> since_key_;   // prepared poses since the last key pose (inclusive)
 
   PoseGraph graph_;
+  std::vector<EdgeKind> edge_kinds_;  // parallel to graph_.edges
   std::vector<KeyPose> key_poses_;
-  Pose2 last_key_smoothed_;  // smoothed pose of the last key pose
+  PreparedPose last_key_;  // prepared pose of the last key pose
   ScanStore scans_;
   std::vector<LoopClosure> closures_;
   int first_unreported_key_ = 0;

@@ -2,6 +2,8 @@
 // Subscribes to the horizontal scans and the frontend's poses; after each optimisation publishes
 // the key poses that changed with their marginal covariances (KEY_POSES, incremental) and each new
 // key pose once on POSE_BACKEND.
+#include <iostream>
+
 #include "backend_node.hpp"
 #include "process.hpp"
 
@@ -17,6 +19,11 @@ int main(int argc, char** argv) {
   const int rc = proc.spin([&node] { node.report_counters(); });
   node.finish();
   node.report_counters();
+  if (const std::string fault = node.backend().input_fault(); !fault.empty()) {
+    std::cerr << "traverse-backend: " << fault << "\n";
+    proc.publish_status("failed: " + fault);
+    return rc != 0 ? rc : traverse::backend::kNoTrajectoryExitCode;
+  }
   proc.publish_status("stopped");
   return rc;
 }

@@ -6,6 +6,7 @@
 #include "config.hpp"
 #include "scan_message.hpp"
 #include "traverse/key_poses_t.hpp"
+#include "traverse/pose_graph_edges_t.hpp"
 
 namespace traverse::backend {
 namespace {
@@ -24,6 +25,7 @@ std::optional<std::string> validate(const BackendNodeConfig& c) {
   check.not_empty("pose_channel", c.pose_channel);
   check.not_empty("key_poses_channel", c.key_poses_channel);
   check.not_empty("trajectory_channel", c.trajectory_channel);
+  check.not_empty("edges_channel", c.edges_channel);
   check.in_range("max_poses_per_message", c.max_poses_per_message, 1, 580);
   check.not_negative("publish_move_m", c.publish_move_m);
   check.not_negative("publish_turn_rad", c.publish_turn_rad);
@@ -37,13 +39,26 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
   bus_.subscribe<planar_scan_t>(config_.scan_channel,
                                 [this](const planar_scan_t& m) { on_scan(m); });
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
+  if (!config_.odometry_channel.empty()) {
+    bus_.subscribe<odometry_t>(config_.odometry_channel,
+                               [this](const odometry_t& m) { on_odometry(m); });
+  }
+}
+
+void BackendNode::on_odometry(const odometry_t& msg) {
+  if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
+  backend_.add_odometry(msg.utime, Pose2(msg.x, msg.y, msg.theta));
 }
 
 void BackendNode::on_scan(const planar_scan_t& msg) { backend_.add_scan(to_planar_scan(msg)); }
 
 void BackendNode::on_pose(const pose2d_t& msg) {
   if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
-  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta))) publish(*update);
+  Eigen::Matrix3d covariance;
+  for (int i = 0; i < 9; ++i) covariance(i / 3, i % 3) = msg.covariance[i];
+  if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta), covariance)) {
+    publish(*update);
+  }
 }
 
 void BackendNode::finish() {
@@ -53,7 +68,7 @@ void BackendNode::finish() {
 bool BackendNode::changed(int i) const {
   if (i >= static_cast<int>(published_.size())) return true;
   const Published& p = published_[i];
-  const Pose2& T = backend_.graph().poses[i];
+  const Pose2& T = backend_.key_poses()[i].T_world_base;
   if ((T.translation() - p.T_world_base.translation()).norm() > config_.publish_move_m) return true;
   if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
     return true;
@@ -67,16 +82,60 @@ bool BackendNode::changed(int i) const {
   return false;
 }
 
+// The edges appended since the last call. The graph has no edge kinds: an edge between
+// non-consecutive key poses is a loop closure, the second edge of a consecutive pair is the
+// frontend's motion (backend.cpp adds the link first).
+void BackendNode::publish_new_edges(int32_t optimisation) {
+  const std::vector<Edge>& edges = backend_.graph().edges;
+  const std::vector<KeyPose>& keys = backend_.key_poses();
+  // 125 bytes per edge: at most 500 keep a part under 64 KB.
+  const std::size_t per = static_cast<std::size_t>(std::min(config_.max_poses_per_message, 500));
+  const std::size_t first = edges_published_;
+  const int parts = static_cast<int>((edges.size() - first + per - 1) / per);
+  for (int part = 0; part < parts; ++part) {
+    pose_graph_edges_t msg{};
+    msg.utime = keys.back().utime;
+    msg.optimisation = optimisation;
+    msg.part = part;
+    msg.parts = parts;
+    msg.total_edges = static_cast<int32_t>(edges.size());
+    msg.first_index = static_cast<int32_t>(first + part * per);
+    for (std::size_t k = msg.first_index; k < std::min(edges.size(), first + (part + 1) * per);
+         ++k) {
+      const Edge& e = edges[k];
+      pose_graph_edge_t m{};
+      m.utime = keys[e.to].utime;
+      m.index = static_cast<int32_t>(k);
+      m.from_id = e.from;
+      m.to_id = e.to;
+      const bool consecutive = e.to == e.from + 1;
+      const bool repeated = k > 0 && edges[k - 1].from == e.from && edges[k - 1].to == e.to;
+      m.kind = !consecutive ? pose_graph_edge_t::KIND_LOOP_CLOSURE
+               : repeated   ? pose_graph_edge_t::KIND_FRONTEND
+                            : pose_graph_edge_t::KIND_LINK;
+      m.x = e.T_from_to.x();
+      m.y = e.T_from_to.y();
+      m.theta = e.T_from_to.theta();
+      copy_matrix(e.information, m.information);
+      msg.edges.push_back(m);
+    }
+    msg.n_edges = static_cast<int32_t>(msg.edges.size());
+    bus_.publish(config_.edges_channel, msg);
+  }
+  edges_published_ = edges.size();
+}
+
 void BackendNode::publish(const BackendUpdate& update) {
   const std::vector<KeyPose>& keys = backend_.key_poses();
   const PoseGraph& graph = backend_.graph();
   if (keys.empty()) return;
+  publish_new_edges(update.optimisation);
   std::vector<int> changed_ids;
   for (int i = 0; i < static_cast<int>(keys.size()); ++i) {
     if (changed(i)) changed_ids.push_back(i);
   }
   published_.resize(keys.size());
-  for (int i : changed_ids) published_[i] = {graph.poses[i], keys[i].covariance.diagonal()};
+  for (int i : changed_ids) published_[i] = {keys[i].T_world_base, keys[i].covariance.diagonal()};
 
   const int per = config_.max_poses_per_message;
   const int parts = std::max(1, static_cast<int>((changed_ids.size() + per - 1) / per));
@@ -98,9 +157,9 @@ void BackendNode::publish(const BackendUpdate& update) {
       key_pose_t p{};
       p.utime = keys[i].utime;
       p.id = i;
-      p.x = graph.poses[i].x();
-      p.y = graph.poses[i].y();
-      p.theta = graph.poses[i].theta();
+      p.x = keys[i].T_world_base.x();
+      p.y = keys[i].T_world_base.y();
+      p.theta = keys[i].T_world_base.theta();
       copy_matrix(keys[i].covariance, p.covariance);
       msg.poses.push_back(p);
     }
@@ -134,9 +193,9 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.utime = keys[i].utime;
     pose.parent_frame = "world";
     pose.child_frame = "base";
-    pose.x = graph.poses[i].x();
-    pose.y = graph.poses[i].y();
-    pose.theta = graph.poses[i].theta();
+    pose.x = keys[i].T_world_base.x();
+    pose.y = keys[i].T_world_base.y();
+    pose.theta = keys[i].T_world_base.theta();
     copy_matrix(keys[i].covariance, pose.covariance);
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
@@ -147,15 +206,23 @@ void BackendNode::report_counters() {
   if (!counters_) return;
   const BackendCounters& c = backend_.counters();
   const LoopCloserCounters& l = backend_.loop_counters();
-  counters_("poses_received", static_cast<double>(c.poses));
+  counters_("poses_received", static_cast<double>(c.prep.poses));
+  counters_("poses_out_of_order", static_cast<double>(c.prep.out_of_order));
+  counters_("poses_sparse", static_cast<double>(c.prep.sparse_poses));
   counters_("scans_received", static_cast<double>(c.scans));
-  counters_("jumps_smoothed", static_cast<double>(c.jumps_smoothed));
-  counters_("outliers_replaced", static_cast<double>(c.outliers_replaced));
+  counters_("jumps_smoothed", static_cast<double>(c.prep.jumps_smoothed));
+  counters_("outliers_replaced", static_cast<double>(c.prep.outliers_replaced));
   counters_("key_poses", static_cast<double>(backend_.key_poses().size()));
   counters_("key_poses_without_scan", static_cast<double>(c.key_poses_without_scan));
   counters_("links_matched", static_cast<double>(c.links_matched));
   counters_("links_fallback", static_cast<double>(c.links_fallback));
   counters_("links_refined", static_cast<double>(c.links_refined));
+  const OdometryCounters& o = backend_.odometry_counters();
+  counters_("odometry_readings", static_cast<double>(o.readings));
+  counters_("odometry_out_of_order", static_cast<double>(o.readings_out_of_order));
+  counters_("odometry_steps_checked", static_cast<double>(o.steps_checked));
+  counters_("odometry_steps_contradicted", static_cast<double>(o.steps_contradicted));
+  counters_("frontend_steps_replaced_by_odometry", static_cast<double>(c.frontend_steps_replaced));
   counters_("loop_closures", static_cast<double>(backend_.closures().size()));
   counters_("loop_episodes", static_cast<double>(l.episodes));
   counters_("loop_candidates", static_cast<double>(l.candidates));
@@ -165,6 +232,7 @@ void BackendNode::report_counters() {
   counters_("loop_refined", static_cast<double>(l.refined));
   counters_("loop_refine_failed", static_cast<double>(l.refine_failed));
   counters_("loop_rejected_inconsistent", static_cast<double>(l.rejected_inconsistent));
+  counters_("loop_rejected_graph", static_cast<double>(c.closures_rejected_inconsistent));
   counters_("optimisations", static_cast<double>(c.optimisations));
   counters_("optimisations_failed", static_cast<double>(c.optimisations_failed));
   counters_("optimisation_last_s", c.last_optimisation_s);

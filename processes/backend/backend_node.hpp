@@ -1,7 +1,9 @@
 // Adapts LCM messages to the backend: planar_scan_t (horizontal scanner) and the frontend's
 // pose2d_t in; after each optimisation, key_poses_t on KEY_POSES with only the key poses that
 // appeared, moved or whose marginal covariance changed (split into parts that each fit one UDP
-// datagram), and each new key pose once as pose2d_t (FLAG_KEY_POSE) on POSE_BACKEND.
+// datagram), and each new key pose once as pose2d_t (FLAG_KEY_POSE) on POSE_BACKEND. Just before
+// each KEY_POSES update, the pose-graph edges added since the previous one on POSE_GRAPH_EDGES
+// (pose_graph_edges_t, in parts of at most max_poses_per_message edges).
 #pragma once
 
 #include <functional>
@@ -12,6 +14,7 @@
 #include "backend.hpp"
 #include "bus.hpp"
 #include "channels.hpp"
+#include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
 
@@ -20,8 +23,10 @@ namespace traverse::backend {
 struct BackendNodeConfig {
   std::string scan_channel = channels::kScanHorizontal;
   std::string pose_channel = channels::kPoseFrontend;
+  std::string odometry_channel = channels::kOdometry;  // odometry_t; empty: none
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
+  std::string edges_channel = channels::kPoseGraphEdges;
   int max_poses_per_message = 400;          // 112 bytes each: 400 keep a part under 64 KB
   double publish_move_m = 0.001;            // a key pose moved farther than this is republished [m]
   double publish_turn_rad = 0.0005;         // ... or turned more than this [rad]
@@ -32,8 +37,10 @@ struct BackendNodeConfig {
   void visit(V& v) {
     v("scan_channel", scan_channel);
     v("pose_channel", pose_channel);
+    v("odometry_channel", odometry_channel);
     v("key_poses_channel", key_poses_channel);
     v("trajectory_channel", trajectory_channel);
+    v("edges_channel", edges_channel);
     v("max_poses_per_message", max_poses_per_message);
     v("publish_move_m", publish_move_m);
     v("publish_turn_rad", publish_turn_rad);
@@ -44,6 +51,9 @@ struct BackendNodeConfig {
 
 // An error message when a value is out of range, empty when the config is valid.
 std::optional<std::string> validate(const BackendNodeConfig& config);
+
+// traverse-backend's exit code when its input gave no trajectory (Backend::input_fault()).
+inline constexpr int kNoTrajectoryExitCode = 3;
 
 class BackendNode {
  public:
@@ -61,7 +71,9 @@ class BackendNode {
  private:
   void on_scan(const planar_scan_t& msg);
   void on_pose(const pose2d_t& msg);
+  void on_odometry(const odometry_t& msg);
   void publish(const BackendUpdate& update);
+  void publish_new_edges(int32_t optimisation);
   bool changed(int index) const;
 
   Bus& bus_;
@@ -75,6 +87,7 @@ class BackendNode {
   std::vector<Published> published_;
   std::size_t max_message_bytes_ = 0;
   long messages_ = 0;
+  std::size_t edges_published_ = 0;
 };
 
 }  // namespace traverse::backend

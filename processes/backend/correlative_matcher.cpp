@@ -67,6 +67,9 @@ class LookupTable {
   correlative::ScoreTable scores_;
 };
 
+// [cells] the largest lookup table built (4 bytes a cell, twice with the block bounds): 256 MB.
+constexpr double kMaxTableCells = 32.0 * 1024 * 1024;
+
 }  // namespace
 
 std::optional<std::string> validate(const CorrelativeMatcherConfig& c) {
@@ -97,24 +100,48 @@ std::optional<std::string> validate(const CorrelativeMatcherConfig& c) {
 CorrelativeMatcher::CorrelativeMatcher(CorrelativeMatcherConfig config)
     : config_(std::move(config)) {}
 
-MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& reference_world,
+MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& reference_all,
                                       const std::vector<Eigen::Vector2d>& query_all,
                                       const Pose2& T_world_guess,
                                       double second_peak_exclusion_m) const {
   MatchResult result;
-  if (reference_world.empty() || query_all.empty()) return result;
+  if (reference_all.empty() || query_all.empty()) return result;
+  if (!Eigen::Vector3d(T_world_guess.x(), T_world_guess.y(), T_world_guess.theta()).allFinite()) {
+    return result;
+  }
   const CorrelativeMatcherConfig& c = config_;
   const double res = c.resolution_m, step = c.angle_step_rad;
   const int W = static_cast<int>(std::ceil(c.linear_window_m / res));
   const int A = static_cast<int>(std::ceil(c.angular_window_rad / step));
-  const LookupTable table(reference_world, res, c.kernel_sigma_m, 3.0 * c.kernel_sigma_m);
-  const correlative::BlockBound coarse(table.scores(), c.coarse_factor);
 
-  // Query points thinned evenly.
+  // Query points thinned evenly (non-finite ones left out), and how far they reach from the
+  // query's origin.
   const std::size_t stride = (query_all.size() + c.max_query_points - 1) / c.max_query_points;
   std::vector<Eigen::Vector2d> query;
-  for (std::size_t i = 0; i < query_all.size(); i += stride) query.push_back(query_all[i]);
+  double reach = 0.0;
+  for (std::size_t i = 0; i < query_all.size(); i += stride) {
+    if (!query_all[i].allFinite()) continue;
+    query.push_back(query_all[i]);
+    reach = std::max(reach, query_all[i].norm());
+  }
+  if (query.empty()) return result;
   const double n = static_cast<double>(query.size());
+  // The table only needs the reference points a query point can land near at some pose of the
+  // search window: within its reach plus the window's corner and the kernel's margin of the
+  // guess. A larger table than kMaxTableCells (points scattered by a wrong pose, garbage
+  // extents) is no match rather than an allocation without bound.
+  const double margin = 3.0 * c.kernel_sigma_m;
+  reach += std::sqrt(2.0) * (W + c.coarse_factor) * res + 2.0 * margin;
+  if (std::pow(2.0 * reach / res, 2) > kMaxTableCells) return result;
+  std::vector<Eigen::Vector2d> reference_world;
+  for (const Eigen::Vector2d& p : reference_all) {
+    if (p.allFinite() && (p - T_world_guess.translation()).cwiseAbs().maxCoeff() <= reach) {
+      reference_world.push_back(p);
+    }
+  }
+  if (reference_world.empty()) return result;
+  const LookupTable table(reference_world, res, c.kernel_sigma_m, margin);
+  const correlative::BlockBound coarse(table.scores(), c.coarse_factor);
   const correlative::RotatedScans scans(query, T_world_guess, A, step,
                                         [&](const Eigen::Vector2d& p) { return table.index(p); });
 

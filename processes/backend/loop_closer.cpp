@@ -23,6 +23,7 @@ std::optional<std::string> validate(const LoopCloserConfig& c) {
   check.positive("max_sigma_xy_m", c.max_sigma_xy_m);
   check.positive("max_sigma_theta_rad", c.max_sigma_theta_rad);
   check.not_negative("max_correction_mahalanobis", c.max_correction_mahalanobis);
+  check.positive("covariance_scale", c.covariance_scale);
   check.nested("coarse", validate(c.coarse));
   check.nested("fine", validate(c.fine));
   check.nested("refine", validate(c.refine));
@@ -69,7 +70,7 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   }
 
   Pose2 T_world_current = fine.T_world_query;
-  Eigen::Matrix3d covariance = fine.covariance;
+  Eigen::Matrix3d covariance = config_.covariance_scale * fine.covariance;
   if (config_.refine.enabled) {
     const RefineResult refined = refiner_.refine(reference, query, fine.T_world_query);
     if (refined.valid) {

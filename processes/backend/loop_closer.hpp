@@ -47,6 +47,9 @@ struct LoopCloserConfig {
   //    covariance and the marginals of both key poses: above this Mahalanobis distance the
   //    closure contradicts the graph (0: not checked).
   double max_correction_mahalanobis = 5.0;
+  // The closure's covariance is the fine match's (the spread of its response surface) times
+  // this [unitless].
+  double covariance_scale = 1.0;
   // Coarse: a wide window (the drift a loop can carry) on a 5 cm grid, almost no penalty.
   CorrelativeMatcherConfig coarse{.resolution_m = 0.05,
                                   .coarse_factor = 8,
@@ -92,6 +95,7 @@ struct LoopCloserConfig {
     v("max_sigma_xy_m", max_sigma_xy_m);
     v("max_sigma_theta_rad", max_sigma_theta_rad);
     v("max_correction_mahalanobis", max_correction_mahalanobis);
+    v("covariance_scale", covariance_scale);
     v("coarse", coarse);
     v("fine", fine);
     v("refine", refine);
@@ -111,6 +115,9 @@ struct LoopClosure {
   double response = 0.0;     // fine raw response [0..1]
   double second_peak = 0.0;  // coarse ambiguity ratio (second peak / peak)
   int candidates_tried = 0;  // candidates of the episode
+  // [unitless] how much the pose graph's chi2 grew when the closure was added (the backend's
+  // trial optimisation); 0 when not checked.
+  double chi2_increase = 0.0;
 };
 
 struct LoopCloserCounters {

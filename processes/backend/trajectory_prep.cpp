@@ -2,54 +2,86 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 
 #include "config.hpp"
 
 namespace traverse::backend {
 namespace {
 
-// Time from a to b [s]; equal times count as 1 us.
-double seconds(const StampedPose& a, const StampedPose& b) {
-  return 1e-6 * static_cast<double>(std::max<int64_t>(b.utime - a.utime, 1));
-}
-
-// A step as a body-frame velocity: (vx [m/s], vy [m/s], omega [rad/s]).
-Eigen::Vector3d velocity(const StampedPose& a, const StampedPose& b) {
-  const Pose2 step = between(a.T_world_base, b.T_world_base);
-  return Eigen::Vector3d(step.x(), step.y(), step.theta()) / seconds(a, b);
-}
-
-// Whether velocity v over dt [s] is a jump against the mean velocity of the preceding steps.
-bool is_jump(const Eigen::Vector3d& v, double dt, const Eigen::Vector3d& mean,
-             const JumpSmoothingConfig& c) {
-  const Eigen::Vector3d deviation = (v - mean) * dt;
-  if (deviation.head<2>().norm() <= c.min_jump_m && std::abs(deviation.z()) <= c.min_jump_rad) {
-    return false;
-  }
-  const double speed = v.head<2>().norm(), mean_speed = mean.head<2>().norm();
-  if (speed > c.min_jump_speed_mps && speed > c.speed_ratio * mean_speed) return true;
-  if (std::abs(v.z()) > c.max_turn_rate_radps) return true;
-  if (mean_speed > c.min_moving_speed_mps && speed > c.min_moving_speed_mps) {
-    const double cosine = v.head<2>().dot(mean.head<2>()) / (speed * mean_speed);
-    if (std::acos(std::clamp(cosine, -1.0, 1.0)) > c.max_direction_change_rad) return true;
-  }
-  return false;
-}
+constexpr std::size_t kRecentIntervals = 5;  // as the frontend's rule
 
 }  // namespace
 
-std::optional<std::string> validate(const JumpSmoothingConfig& c) {
-  ConfigCheck check;
-  check.in_range("window", c.window, 1, 1000);
-  check.positive("speed_ratio", c.speed_ratio);
-  check.not_negative("min_jump_speed_mps", c.min_jump_speed_mps);
-  check.positive("max_direction_change_rad", c.max_direction_change_rad);
-  check.not_negative("min_moving_speed_mps", c.min_moving_speed_mps);
-  check.positive("max_turn_rate_radps", c.max_turn_rate_radps);
-  check.not_negative("min_jump_m", c.min_jump_m);
-  check.not_negative("min_jump_rad", c.min_jump_rad);
-  return check.problem();
+TrajectoryPrep::TrajectoryPrep(JumpSmoothingConfig config)
+    : config_(std::move(config)), smoother_(config_) {}
+
+bool TrajectoryPrep::sparse() const {
+  if (config_.input == "stream") return false;
+  if (config_.input == "sparse") return true;
+  if (intervals_us_.size() < kRecentIntervals) return false;
+  // A scanner's stream: every recent interval within [min_stream_interval_us,
+  // sparse_interval_us]. One longer (a log subsampled by travel) or shorter (stamps squeezed
+  // together where a log's clock failed) says the times do not pace the motion.
+  const auto [lo, hi] = std::minmax_element(intervals_us_.begin(), intervals_us_.end());
+  return *hi > config_.sparse_interval_us || *lo < config_.min_stream_interval_us;
+}
+
+std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {
+  ++counters_.poses;
+  const int64_t last_utime = held_ ? held_->utime : (last_ ? last_->utime : INT64_MIN);
+  if (pose.utime <= last_utime) {
+    ++counters_.out_of_order;
+    return std::nullopt;
+  }
+  if (last_utime != INT64_MIN) {
+    intervals_us_.push_back(pose.utime - last_utime);
+    if (intervals_us_.size() > kRecentIntervals) intervals_us_.pop_front();
+  }
+  if (!held_) {
+    held_ = pose;
+    return std::nullopt;
+  }
+  const FrontendPose held = *held_;
+  held_ = pose;
+  return prepare(held, pose);
+}
+
+std::optional<PreparedPose> TrajectoryPrep::finish() {
+  if (!held_) return std::nullopt;
+  const FrontendPose held = *held_;
+  held_.reset();
+  return prepare(held, std::nullopt);
+}
+
+PreparedPose TrajectoryPrep::prepare(FrontendPose pose, const std::optional<FrontendPose>& next) {
+  PreparedPose out;
+  out.utime = pose.utime;
+  out.sparse = sparse();
+  const StampedPose raw{pose.utime, pose.T_map_base};
+  if (!last_) {
+    out.T_world_base = pose.T_map_base;
+    smoother_.restart(raw, out.T_world_base);
+  } else if (out.sparse) {
+    // Subsampled by travel: the frontend's step as it is.
+    ++counters_.sparse_poses;
+    out.T_world_base = last_->T_world_base * between(last_->frontend.T_map_base, pose.T_map_base);
+    smoother_.restart(raw, out.T_world_base);
+  } else {
+    if (next && smoother_.is_outlier(raw, {next->utime, next->T_map_base})) {
+      ++counters_.outliers_replaced;
+      pose.T_map_base = smoother_.replace_outlier(raw, {next->utime, next->T_map_base});
+    }
+    bool jump = false;
+    out.T_world_base = smoother_.add({pose.utime, pose.T_map_base}, jump);
+    if (jump) ++counters_.jumps_smoothed;
+  }
+  out.frontend = pose;
+  out.travel_m =
+      last_ ? last_->travel_m +
+                  (out.T_world_base.translation() - last_->T_world_base.translation()).norm()
+            : 0.0;
+  last_ = out;
+  return out;
 }
 
 std::optional<std::string> validate(const KeyPoseConfig& c) {
@@ -58,55 +90,6 @@ std::optional<std::string> validate(const KeyPoseConfig& c) {
   check.not_negative("distance_m", c.distance_m);
   check.not_negative("angle_rad", c.angle_rad);
   return check.problem();
-}
-
-SmoothedTrajectory smooth_jumps(std::vector<StampedPose> poses, const JumpSmoothingConfig& config) {
-  SmoothedTrajectory out;
-  if (poses.empty()) return out;
-  out.poses.push_back(poses.front());
-  std::deque<Eigen::Vector3d> recent;  // velocities of the preceding (accepted) steps
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (std::size_t k = 1; k < poses.size(); ++k) {
-    // An outlier: pose k lies off the path from k - 1 to k + 1 by more than the minimum and
-    // more than half that path's length (or turn), so it is not a curve of it, while that path
-    // itself moves as the preceding steps did (else pose k + 1 shares a jump).
-    const bool judged = static_cast<int>(recent.size()) == config.window;
-    if (judged && k + 1 < poses.size()) {
-      const Eigen::Vector3d mean = sum / static_cast<double>(recent.size());
-      const double s = seconds(poses[k - 1], poses[k]) / seconds(poses[k - 1], poses[k + 1]);
-      const Pose2 on_path = interpolate(poses[k - 1].T_world_base, poses[k + 1].T_world_base, s);
-      const Pose2 off = between(on_path, poses[k].T_world_base);
-      const Pose2 path = between(poses[k - 1].T_world_base, poses[k + 1].T_world_base);
-      const bool off_path =
-          off.translation().norm() > std::max(config.min_jump_m, 0.5 * path.translation().norm()) ||
-          std::abs(off.theta()) > std::max(config.min_jump_rad, 0.5 * std::abs(path.theta()));
-      if (off_path && !is_jump(velocity(poses[k - 1], poses[k + 1]),
-                               seconds(poses[k - 1], poses[k + 1]), mean, config)) {
-        poses[k].T_world_base = on_path;
-        out.outliers.push_back(static_cast<int>(k));
-      }
-    }
-    Eigen::Vector3d v = velocity(poses[k - 1], poses[k]);
-    // Only judge once the window is full: the average must describe the recent motion.
-    if (judged) {
-      const Eigen::Vector3d mean = sum / static_cast<double>(recent.size());
-      if (is_jump(v, seconds(poses[k - 1], poses[k]), mean, config)) {
-        v = mean;
-        out.replaced_steps.push_back(static_cast<int>(k));
-      }
-    }
-    recent.push_back(v);
-    sum += v;
-    if (static_cast<int>(recent.size()) > config.window) {
-      sum -= recent.front();
-      recent.pop_front();
-    }
-    // Carry the rest of the trajectory along: compose the (possibly replaced) step.
-    const double dt = seconds(poses[k - 1], poses[k]);
-    const Pose2 step(v.x() * dt, v.y() * dt, v.z() * dt);
-    out.poses.push_back({poses[k].utime, out.poses.back().T_world_base * step});
-  }
-  return out;
 }
 
 std::vector<int> select_key_poses(const std::vector<StampedPose>& poses,

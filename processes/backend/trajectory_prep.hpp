@@ -1,71 +1,83 @@
-// Preparing the frontend's dense trajectory for the backend (seed 000, section "pipeline"):
-//  1. Jump smoothing. A scan matcher without a backend recovers from accumulated drift at a loop
-//     with a discrete jump. Each step between consecutive poses is compared with the average of
-//     the preceding steps (as velocities, so uneven scan timing does not matter); a step much
-//     longer, or in a clearly different direction, is replaced by that average, and the rest of
-//     the trajectory is carried along so it stays continuous. A single bad pose that the next pose
-//     returns from (it lies off the path between its neighbours by more than half that path's
-//     length) is an outlier, not a jump: it is replaced by interpolating its neighbours, and
-//     nothing after it moves. Deviations from the average motion below min_jump_m / min_jump_rad
-//     are never jumps: they are scan-matching noise that the backend's own matching handles.
-//  2. Key-pose selection: a pose becomes a key pose when enough time has passed since the last
+// Preparing the frontend's trajectory for the backend (seed 000, section "pipeline"), one pose at
+// a time:
+//  1. Poses out of time order are dropped (counted): the backend's times must increase.
+//  2. The kind of input is told from the intervals between poses: a scanner's stream (tens of
+//     poses per second) or a log subsampled by travel (a scan kept every metre or half radian,
+//     seconds apart; the CARMEN sets), by the last five intervals: a stream has all of them
+//     within [min_stream_interval_us, sparse_interval_us], so stamps squeezed together where a
+//     log's clock failed do not pass for a fast scanner (stricter than the frontend's median, which
+//     took Kummerle's full-rate intel for a stream half the time). Each kind has its own jump
+//     handling: a scanner's stream gets seed 000's jump smoothing (jump_smoothing.hpp); on a log
+//     subsampled by travel, where real steps of 0.5-1.8 m and 0.5 rad come seconds apart, a step
+//     says nothing about the next one, so the poses pass unchanged and the pose graph weighs each
+//     step by the frontend's covariance.
+//  3. Key-pose selection: a pose becomes a key pose when enough time has passed since the last
 //     one (seed 000 uses three per second), or when the platform has moved or turned enough.
-// Poses are T_world_base, times in microseconds.
+// Poses are T_world_base (the prepared frame, which starts equal to the frontend's map frame),
+// times in microseconds.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "jump_smoothing.hpp"
 #include "se2.hpp"
 
 namespace traverse::backend {
 
-struct StampedPose {
+struct FrontendPose {
   int64_t utime = 0;  // [us]
-  Pose2 T_world_base;
+  Pose2 T_map_base;   // the frontend's pose
+  // The frontend's covariance of (x [m], y [m], theta [rad]) in its map frame: m^2, m rad, rad^2
+  // (zero: unknown).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
-struct JumpSmoothingConfig {
-  int window = 10;                        // preceding steps averaged [steps]
-  double speed_ratio = 3.0;               // a step faster than ratio * average speed is a jump
-  double min_jump_speed_mps = 0.5;        // ... and faster than this [m/s] (ignores jitter at rest)
-  double max_direction_change_rad = 1.0;  // step direction vs average direction, while moving
-  double min_moving_speed_mps = 0.1;  // below this average speed, direction is not checked [m/s]
-  double max_turn_rate_radps = 3.0;   // a heading rate above this [rad/s] is a jump
-  // A jump displaces the pose by more than this from the average [m] or turns it by more than
-  // this [rad]: only a frontend recovering at a loop; smaller strays are left to the links' scan
-  // matching. Measured offline on office-s1, where the frontend strays 0.2 m for a while: 1.33 mm
-  // position RMSE with these, 14.3 mm with 5 mm / 5 mrad and 17.1 mm with 5 cm / 0.05 rad.
-  double min_jump_m = 0.3;
-  double min_jump_rad = 0.1;
-
-  template <class V>
-  void visit(V& v) {
-    v("window", window);
-    v("speed_ratio", speed_ratio);
-    v("min_jump_speed_mps", min_jump_speed_mps);
-    v("max_direction_change_rad", max_direction_change_rad);
-    v("min_moving_speed_mps", min_moving_speed_mps);
-    v("max_turn_rate_radps", max_turn_rate_radps);
-    v("min_jump_m", min_jump_m);
-    v("min_jump_rad", min_jump_rad);
-  }
+struct PreparedPose {
+  int64_t utime = 0;      // [us]
+  Pose2 T_world_base;     // prepared (smoothed where the strategy smooths)
+  FrontendPose frontend;  // the frontend's pose (an outlier replaced by its neighbours')
+  double travel_m = 0.0;  // [m] distance along the prepared trajectory from its first pose
+  bool sparse = false;    // taken as a log subsampled by travel
 };
 
-std::optional<std::string> validate(const JumpSmoothingConfig& config);
-
-struct SmoothedTrajectory {
-  std::vector<StampedPose> poses;
-  std::vector<int> replaced_steps;  // index k of every step k-1 -> k replaced by the average
-  std::vector<int> outliers;        // index k of every pose replaced by its neighbours' average
+struct TrajectoryPrepCounters {
+  long poses = 0;              // frontend poses given
+  long out_of_order = 0;       // ... dropped: not later than the pose before
+  long sparse_poses = 0;       // prepared as a log subsampled by travel
+  long jumps_smoothed = 0;     // frontend steps replaced by the average (a scanner's stream)
+  long outliers_replaced = 0;  // single poses replaced by their neighbours' average (same)
 };
 
-// Returns the trajectory with jumps and outliers replaced; the first pose is kept as is, and the
-// last is never an outlier (nothing follows it). Poses must be in time order (equal times are
-// treated as a 1 us step).
-SmoothedTrajectory smooth_jumps(std::vector<StampedPose> poses, const JumpSmoothingConfig& config);
+class TrajectoryPrep {
+ public:
+  // The config must pass validate().
+  explicit TrajectoryPrep(JumpSmoothingConfig config);
+
+  // Takes in a frontend pose; returns the pose before it, prepared: a pose can be told from an
+  // outlier only once the next one is known.
+  std::optional<PreparedPose> add(const FrontendPose& pose);
+  // End of data: the held pose, prepared.
+  std::optional<PreparedPose> finish();
+
+  const TrajectoryPrepCounters& counters() const { return counters_; }
+
+ private:
+  // Whether the poses are taken as a log subsampled by travel (after the newest interval).
+  bool sparse() const;
+  PreparedPose prepare(FrontendPose pose, const std::optional<FrontendPose>& next);
+
+  JumpSmoothingConfig config_;
+  JumpSmoother smoother_;
+  TrajectoryPrepCounters counters_;
+  std::optional<FrontendPose> held_;  // the newest pose, not yet prepared
+  std::optional<PreparedPose> last_;  // the last prepared pose
+  std::deque<int64_t> intervals_us_;  // the last intervals between poses given [us]
+};
 
 struct KeyPoseConfig {
   int64_t interval_us = 333333;  // a key pose at least this often [us]

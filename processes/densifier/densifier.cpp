@@ -22,6 +22,8 @@ std::optional<std::string> validate(const DensifierConfig& c) {
   // above 64 KB it no longer fits one UDP datagram.
   check.in_range("max_message_bytes", c.max_message_bytes, 4096, 65000);
   check.not_negative("spike_threshold_m", c.spike_threshold_m);
+  check.not_negative("spike_max_span_us", c.spike_max_span_us);
+  check.not_negative("spike_min_interval_us", c.spike_min_interval_us);
   return check.problem();
 }
 
@@ -163,6 +165,11 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   const StampedPose& a = dense_[n - 3];
   const StampedPose& b = dense_[n - 1];
   StampedPose& p = dense_[n - 2];
+  if (b.utime - a.utime > config_.spike_max_span_us) return;
+  const int64_t in = p.utime - a.utime, out_us = b.utime - p.utime;
+  if (std::min(in, out_us) < config_.spike_min_interval_us) return;
+  // A scanner's stream comes at a steady rate; uneven intervals are a log's restamped times.
+  if (std::max(in, out_us) > 2 * std::min(in, out_us)) return;
   const Pose2 q = interpolate_between(a, b, p.utime);
   const double off = (p.T_world_base.translation() - q.translation()).norm();
   const double chord = (b.T_world_base.translation() - a.T_world_base.translation()).norm();

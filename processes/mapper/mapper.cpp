@@ -381,7 +381,7 @@ void Mapper::for_each_point(const std::function<void(const CloudPoint&)>& f) con
     if (!place(s, pts, beams)) continue;
     const double dt = static_cast<double>(s.utime_last - s.utime_first) / (s.range_q.size() - 1);
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      f({pts[i], s.intensity[beams[i]], s.utime_first + std::llround(beams[i] * dt), s.key_id});
+      f({pts[i], s.intensity[beams[i]], s.utime_first + std::llround(beams[i] * dt), s.key_id, {}});
     }
   }
 }

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "planar_scan.hpp"
+#include "point_colours.hpp"
 #include "trajectory_store.hpp"
 
 namespace traverse::mapper {
@@ -61,8 +62,9 @@ struct MapperConfig {
   Footprint footprint;
   std::string rig_file = "configs/rig.yaml";  // laser_profile extrinsic T_base_laser
   std::string output_dir = "out/mapper";      // exports: cloud.ply, map.bt, map.ot
-  std::string pose_channel;     // "": DENSE_SEGMENTS from the densifier; else pose2d_t stream
-  int poses_per_segment = 40;   // segment length when reading a pose2d_t stream
+  std::string pose_channel;  // "": DENSE_SEGMENTS from the densifier; else pose2d_t stream
+  std::string annotations_channel = "ANNOTATIONS";  // annotations_t colours; "": none
+  int poses_per_segment = 40;                       // segment length when reading a pose2d_t stream
   double max_pending_s = 30.0;  // [s] profiles waiting longer for poses are dropped
   int move_threads = 2;         // threads that place moved profiles again (counts: one thread)
   template <class V>
@@ -74,6 +76,7 @@ struct MapperConfig {
     v("rig_file", rig_file);
     v("output_dir", output_dir);
     v("pose_channel", pose_channel);
+    v("annotations_channel", annotations_channel);
     v("poses_per_segment", poses_per_segment);
     v("max_pending_s", max_pending_s);
     v("move_threads", move_threads);
@@ -94,6 +97,7 @@ struct CloudPoint {
   uint8_t intensity = 0;
   int64_t utime = 0;   // [us]
   int64_t key_id = 0;  // key pose whose segment placed the profile
+  PointColour colour;  // accuracy level and colour (set at export, point_colours.hpp)
 };
 
 class Mapper {

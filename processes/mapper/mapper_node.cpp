@@ -20,6 +20,11 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
   } else {
     bus.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
   }
+  if (!config_.annotations_channel.empty()) {
+    // Parts of one update share a utime.
+    bus.subscribe<annotations_t>(
+        config_.annotations_channel, [this](const annotations_t& m) { on_annotations(m); }, true);
+  }
   if (worker_thread) worker_ = std::thread([this] { run_worker(); });
 }
 
@@ -166,12 +171,18 @@ void MapperNode::finish() {
   settle();
 }
 
+void MapperNode::on_annotations(const annotations_t& msg) {
+  for (const key_annotation_t& k : msg.keys) {
+    if (colours_.set(k.id, k.utime, k.level, {k.rgb[0], k.rgb[1], k.rgb[2]})) ++level_changes_;
+  }
+}
+
 bool MapperNode::export_all(std::string* error) {
   flush();  // the worker is idle now and stays so: this thread is the one that would queue more
   std::error_code ec;
   std::filesystem::create_directories(config_.output_dir, ec);
   const std::filesystem::path dir(config_.output_dir);
-  if (!write_ply((dir / "cloud.ply").string(), mapper_)) {
+  if (!write_ply((dir / "cloud.ply").string(), mapper_, &colours_)) {
     if (error) *error = "cannot write " + (dir / "cloud.ply").string();
     return false;
   }
@@ -197,6 +208,8 @@ void MapperNode::report_counters() {
     lag_max = lag_max_s_;
   }
   counters_("profiles", s.profiles);
+  counters_("annotated_key_poses", static_cast<double>(colours_.size()));
+  counters_("annotation_level_changes", level_changes_);
   counters_("profiles_pending", s.pending);
   counters_("profiles_rejected", s.rejected);
   counters_("profiles_dropped", s.dropped);

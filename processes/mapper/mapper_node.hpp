@@ -4,7 +4,8 @@
 // arrives again with a higher revision, and only the newest revision of each segment is kept, so
 // a revision that arrives late cannot undo a newer one) or, with `pose_channel` set, as a plain
 // pose2d_t stream (e.g. POSE_GROUND_TRUTH) cut into segments of `poses_per_segment` poses that
-// never move.
+// never move. The annotator's colours (annotations_t on ANNOTATIONS) are kept per key pose, newest
+// first, and given to every point at export (cloud.ply's red, green, blue and level).
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
@@ -31,6 +32,7 @@
 
 #include "bus.hpp"
 #include "mapper.hpp"
+#include "traverse/annotations_t.hpp"
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -70,6 +72,7 @@ class MapperNode {
   void on_profile(const planar_scan_t& msg);
   void on_segments(const dense_segments_t& msg);
   void on_pose(const pose2d_t& msg);
+  void on_annotations(const annotations_t& msg);
   void cut_segment();
 
   void submit(Work work);
@@ -86,6 +89,8 @@ class MapperNode {
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first
   double segments_stale_ = 0;
   TrajectorySegment open_;  // pose2d_t stream: poses since the last cut
+  PointColours colours_;    // the annotations, by key pose (this thread only)
+  double level_changes_ = 0;
   int64_t next_key_id_ = 0;
   // Worker side.
   int64_t latest_utime_ = 0;  // [us] newest profile time applied

@@ -9,10 +9,11 @@ namespace traverse::mapper {
 
 namespace {
 
-constexpr std::size_t kRecord = 3 * 4 + 1 + 8 + 4;  // bytes per point
+constexpr std::size_t kRecord = 3 * 4 + 1 + 8 + 4 + 3 + 1;  // bytes per point
 const char* const kProperties =
     "property float x\nproperty float y\nproperty float z\nproperty uchar intensity\n"
-    "property double time\nproperty int key_id\n";
+    "property double time\nproperty int key_id\nproperty uchar red\nproperty uchar green\n"
+    "property uchar blue\nproperty char level\n";
 
 void encode(const CloudPoint& p, char* out) {
   std::memcpy(out, p.p_world.data(), 12);
@@ -21,6 +22,8 @@ void encode(const CloudPoint& p, char* out) {
   std::memcpy(out + 13, &t, 8);
   const int32_t k = static_cast<int32_t>(p.key_id);
   std::memcpy(out + 21, &k, 4);
+  std::memcpy(out + 25, p.colour.rgb.data(), 3);
+  out[28] = static_cast<char>(p.colour.level);
 }
 
 }  // namespace
@@ -31,7 +34,8 @@ bool write_ply(const std::string& path, int64_t count,
   if (!f) return false;
   f << "ply\nformat binary_little_endian 1.0\n"
     << "comment Traverse cloud: x y z [m] in frame world, intensity [0..255], time [s] since "
-       "the Unix epoch, key_id = key pose whose segment placed the point\n"
+       "the Unix epoch, key_id = key pose whose segment placed the point, red green blue level = "
+       "accuracy colour and level of the annotations (-1: none)\n"
     << "element vertex " << count << "\n"
     << kProperties << "end_header\n";
   std::vector<char> buf;
@@ -50,10 +54,16 @@ bool write_ply(const std::string& path, int64_t count,
   return static_cast<bool>(f) && written == count;
 }
 
-bool write_ply(const std::string& path, const Mapper& mapper) {
-  return write_ply(
-      path, mapper.placed_points(),
-      [&mapper](const std::function<void(const CloudPoint&)>& f) { mapper.for_each_point(f); });
+bool write_ply(const std::string& path, const Mapper& mapper, const PointColours* colours) {
+  return write_ply(path, mapper.placed_points(),
+                   [&](const std::function<void(const CloudPoint&)>& f) {
+                     if (!colours) return mapper.for_each_point(f);
+                     mapper.for_each_point([&](const CloudPoint& p) {
+                       CloudPoint coloured = p;
+                       coloured.colour = colours->at(p.utime);
+                       f(coloured);
+                     });
+                   });
 }
 
 std::optional<std::vector<CloudPoint>> read_ply(const std::string& path, std::string* error) {
@@ -87,6 +97,8 @@ std::optional<std::vector<CloudPoint>> read_ply(const std::string& path, std::st
     int32_t k;
     std::memcpy(&k, rec + 21, 4);
     p.key_id = k;
+    std::memcpy(p.colour.rgb.data(), rec + 25, 3);
+    p.colour.level = static_cast<int8_t>(rec[28]);
   }
   return out;
 }

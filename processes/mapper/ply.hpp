@@ -1,7 +1,8 @@
 // Binary PLY (little endian) for the mapper's cloud: x, y, z [m, float32] in the world frame,
 // intensity [0..255, uchar], time [s since the Unix epoch, float64], key_id [int32, the key pose
-// whose segment placed the point]. Opens in CloudCompare and other PLY readers; the reader below
-// reads back exactly this layout (for the evaluation tools).
+// whose segment placed the point], red, green, blue [0..255, uchar] and level [char, the accuracy
+// level index of the annotations, -1 for none] (point_colours.hpp). Opens in CloudCompare and
+// other PLY readers; the reader below reads back exactly this layout (for the evaluation tools).
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "mapper.hpp"
+#include "point_colours.hpp"
 
 namespace traverse::mapper {
 
@@ -19,8 +21,9 @@ namespace traverse::mapper {
 bool write_ply(const std::string& path, int64_t count,
                const std::function<void(const std::function<void(const CloudPoint&)>&)>& each);
 
-// Writes the mapper's whole cloud.
-bool write_ply(const std::string& path, const Mapper& mapper);
+// Writes the mapper's whole cloud, each point coloured by `colours` when given.
+bool write_ply(const std::string& path, const Mapper& mapper,
+               const PointColours* colours = nullptr);
 
 // Reads a file written by write_ply; nullopt (with `error` set) on any other layout.
 std::optional<std::vector<CloudPoint>> read_ply(const std::string& path, std::string* error);

@@ -76,7 +76,7 @@ TEST(JumpSmoothing, ReplacesAnOutlierWithoutMovingWhatFollows) {
   const std::vector<StampedPose> clean = poses;
   poses[50].T_world_base = poses[50].T_world_base * Pose2(0.004, -0.012, 0.0);
   JumpSmoothingConfig config;
-  config.min_jump_m = 0.005;  // a 12 mm outlier counts
+  config.min_jump_m = 0.005;                              // a 12 mm outlier counts
   EXPECT_TRUE(smooth_jumps(poses, {}).outliers.empty());  // by default it is left to the links
   const SmoothedTrajectory s = smooth_jumps(poses, config);
   EXPECT_TRUE(s.replaced_steps.empty());
@@ -137,6 +137,42 @@ TEST(KeyPoses, ByDistanceAndAngle) {
   const std::vector<int> turning = select_key_poses(drive(200, 0.0, 1.0), by_angle);
   EXPECT_EQ(turning.size(), 1u + 199 / 20);  // 0.025 rad per scan: every 20 scans
   EXPECT_EQ(select_key_poses(drive(200, 0.0, 1.0), by_distance).size(), 1u);  // no travel
+}
+
+// A log whose clock failed (Kummerle's full-rate intel: 3,800 of 13,600 intervals under 5 ms,
+// the rest up to seconds): a turn on the spot, 0.15 rad a scan, stamped 80 ms and 2 ms apart by
+// turns. The median interval (2 ms) made it a scanner's stream, the smoothing saw 75 rad/s and
+// replaced real turns (the full graph's headings 10-20 degrees off the frontend's there). Now a
+// stream needs every recent interval between 5 and 100 ms; the prepared poses keep the
+// frontend's steps.
+TEST(TrajectoryPrep, StampsSqueezedTogetherAreNotAStream) {
+  std::vector<StampedPose> poses{{0, Pose2()}};
+  const int64_t intervals_us[] = {80000, 2000, 2000, 80000, 2000};
+  for (int k = 0; k < 40; ++k) {
+    poses.push_back({poses.back().utime + intervals_us[k % 5],
+                     poses.back().T_world_base * Pose2(0.0, 0.0, 0.15)});
+  }
+  for (const int64_t min_stream_us : {int64_t{5000}, int64_t{0}}) {
+    JumpSmoothingConfig config;
+    config.sparse_interval_us = 100000;  // configs/backend.yaml
+    config.min_stream_interval_us = min_stream_us;
+    TrajectoryPrep prep(config);
+    std::vector<PreparedPose> out;
+    for (const StampedPose& p : poses) {
+      if (auto q = prep.add({p.utime, p.T_world_base})) out.push_back(*q);
+    }
+    if (auto q = prep.finish()) out.push_back(*q);
+    ASSERT_EQ(out.size(), poses.size());
+    const double error =
+        std::abs(wrap_angle(out.back().T_world_base.theta() - poses.back().T_world_base.theta()));
+    if (min_stream_us > 0) {
+      EXPECT_EQ(prep.counters().jumps_smoothed + prep.counters().outliers_replaced, 0);
+      EXPECT_LT(error, 1e-9);  // [rad]
+    } else {                   // no lower bound: taken as a stream
+      EXPECT_GT(prep.counters().jumps_smoothed + prep.counters().outliers_replaced, 0);
+      EXPECT_GT(error, 0.1);  // [rad]
+    }
+  }
 }
 
 }  // namespace

@@ -90,3 +90,42 @@ TEST(CorrelativeMatcher, EmptyInputIsInvalid) {
 
 }  // namespace
 }  // namespace traverse::backend
+
+namespace traverse::backend {
+namespace {
+
+// Reference points scattered by a wrong pose (kilometres away, or not finite) used to size the
+// lookup table by their extent: std::bad_alloc on CARMEN intel. The table now covers only what
+// the query can reach from the guess, so the match is the one without them; a query whose points
+// reach beyond any sensible table is no match, not an allocation.
+TEST(CorrelativeMatcher, GarbageExtentsNeitherAllocateNorChangeTheMatch) {
+  std::mt19937 rng(7);
+  const World world = test::synthetic::room();
+  std::vector<Eigen::Vector2d> reference;
+  for (const auto& p : test::key_points(world, Pose2(), 20.0, rng)) {
+    reference.push_back(p.cast<double>());
+  }
+  std::vector<Eigen::Vector2d> query =
+      test::to_double(test::key_points(world, Pose2(0.8, 0.5, 0.3), 20.0, rng));
+  const Pose2 guess(0.9, 0.4, 0.35);
+  const CorrelativeMatcher matcher(wide());
+  const MatchResult clean = matcher.match(reference, query, guess);
+  std::vector<Eigen::Vector2d> garbage = reference;
+  garbage.emplace_back(-1.7e4, 1.8e4);
+  garbage.emplace_back(1e300, -1e300);
+  garbage.emplace_back(std::nan(""), 0.0);
+  const MatchResult m = matcher.match(garbage, query, guess);
+  ASSERT_TRUE(clean.valid && m.valid);
+  EXPECT_LT((m.T_world_query.translation() - clean.T_world_query.translation()).norm(), 0.021);
+  EXPECT_LT(std::abs(wrap_angle(m.T_world_query.theta() - clean.T_world_query.theta())), 0.004);
+
+  query.insert(query.begin(), Eigen::Vector2d(1e9, 0.0));  // thinning keeps the first point
+  EXPECT_FALSE(matcher.match(reference, query, guess).valid);
+  EXPECT_FALSE(matcher
+                   .match(reference, test::to_double(test::key_points(world, Pose2(), 20.0, rng)),
+                          Pose2(std::nan(""), 0.0, 0.0))
+                   .valid);
+}
+
+}  // namespace
+}  // namespace traverse::backend

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "annotator_node.hpp"
 #include "backend_node.hpp"
 #include "carmen_config.hpp"
 #include "cloud_eval.hpp"
@@ -91,6 +92,11 @@ TEST_F(ConfigWalk, Frontend) {
 TEST_F(ConfigWalk, Backend) {
   walk_config<backend::BackendNodeConfig>(
       walk("traverse-backend", "configs/backend.yaml", {"--replay " + path("frontend.lcmlog")}));
+}
+
+TEST_F(ConfigWalk, Annotator) {
+  walk_config<annotator::AnnotatorNodeConfig>(
+      walk("traverse-annotator", "configs/annotator.yaml", {"--replay " + path("backend.lcmlog")}));
 }
 
 TEST_F(ConfigWalk, Densifier) {

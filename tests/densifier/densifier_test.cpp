@@ -162,8 +162,8 @@ TEST(Densifier, MovesBelowTheThresholdWaitUntilTheEnd) {
 TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
   Densifier d(DensifierConfig{});
   std::vector<Segment> closed;
-  ASSERT_TRUE(d.update_key_poses({{0, kT0, Pose2()}, {1, kT0 + 20 * kDt, Pose2(0.1, 0, 0)}})
-                  .empty());
+  ASSERT_TRUE(
+      d.update_key_poses({{0, kT0, Pose2()}, {1, kT0 + 20 * kDt, Pose2(0.1, 0, 0)}}).empty());
   for (int i = 0; i <= 20; ++i) {
     d.add_dense(kT0 + i * kDt, Pose2(0.005 * i, i == 10 ? 0.15 : 0.0, 0), &closed);
   }
@@ -192,6 +192,52 @@ TEST(Densifier, LoneSpikeIsReplacedAndCornersAreKept) {
   f.add_dense(kT0 + 1'000'000, Pose2(1, 0, 0), &closed);
   f.add_dense(kT0 + 2'000'000, Pose2(1, 1, 0), &closed);
   EXPECT_EQ(f.spikes_replaced(), 0);
+
+  // A sparse log turning on the spot (CARMEN intel, scans 336-338): the middle pose comes 3.65 s
+  // after the first and 0.18 s before the last, 6 cm off the path interpolated by time, which is
+  // shorter; its neighbours lie 3.83 s apart, so nothing is known of the path between them, and
+  // it is kept.
+  const auto turn = [](const DensifierConfig& config, int64_t t1, int64_t t2) {
+    Densifier g(config);
+    std::vector<Segment> out;
+    g.add_dense(kT0, Pose2(17.0311, -0.6614, 1.8256), &out);
+    g.add_dense(kT0 + t1, Pose2(17.0485, -0.6493, 1.6204), &out);
+    g.add_dense(kT0 + t2, Pose2(16.9879, -0.6737, 2.1498), &out);
+    return g.spikes_replaced();
+  };
+  EXPECT_EQ(turn(DensifierConfig{}, 3'650'000, 3'830'000), 0);
+  // ... and with any span too, its intervals being uneven (3.65 s and 0.18 s).
+  DensifierConfig any_span;
+  any_span.spike_max_span_us = 4'000'000;
+  EXPECT_EQ(turn(any_span, 3'650'000, 3'830'000), 0);
+  // Neighbours 0.5 s apart, as in a 4 Hz log (CARMEN freiburg-079), are no scanner's stream
+  // either (a span of 0.5 s replaced real turns there); a pose 0.15 m off its neighbours' path at
+  // 10 Hz is a spike.
+  const auto lone = [](const DensifierConfig& config, int64_t period_us) {
+    Densifier g(config);
+    std::vector<Segment> out;
+    g.add_dense(kT0, Pose2(0.0, 0.0, 0.0), &out);
+    g.add_dense(kT0 + period_us, Pose2(0.05, 0.15, 0.0), &out);
+    g.add_dense(kT0 + 2 * period_us, Pose2(0.1, 0.0, 0.0), &out);
+    return g.spikes_replaced();
+  };
+  EXPECT_EQ(lone(DensifierConfig{}, 250'000), 0);
+  DensifierConfig half_second;
+  half_second.spike_max_span_us = 500'000;
+  EXPECT_EQ(lone(half_second, 250'000), 1);
+  EXPECT_EQ(lone(DensifierConfig{}, 100'000), 1);
+  // A turn on the spot whose stamps are squeezed out of the order of the motion (Kummerle's
+  // full-rate intel: 155.9, 146.3, 159.8 degrees within 50 ms, the last two microseconds apart):
+  // a real pose, kept (so are poses between uneven intervals: a stream comes at a steady rate).
+  const auto squeezed = [](const DensifierConfig& config) {
+    Densifier g(config);
+    std::vector<Segment> out;
+    g.add_dense(kT0, Pose2(11.0073, 0.0, 155.9 * M_PI / 180), &out);
+    g.add_dense(kT0 + 50'000, Pose2(11.0400, 0.0, 146.3 * M_PI / 180), &out);
+    g.add_dense(kT0 + 50'003, Pose2(11.0129, 0.0, 159.8 * M_PI / 180), &out);
+    return g.spikes_replaced();
+  };
+  EXPECT_EQ(squeezed(DensifierConfig{}), 0);
 }
 
 }  // namespace

@@ -39,14 +39,17 @@ std::vector<CloudPoint> cloud(const Eigen::Vector3f& shift) {
   for (int i = 0; i < 400; ++i) {
     const float y = -1.9f + 3.8f * static_cast<float>(i) / 400.0f;
     const float z = 0.4f + 2.0f * static_cast<float>(i % 20) / 20.0f;
-    out.push_back({Eigen::Vector3f(0.0f, y, z) + shift, 0, 0, 0});
-    out.push_back({Eigen::Vector3f(10.0f, y, z) + shift, 0, 0, 0});
+    out.push_back({Eigen::Vector3f(0.0f, y, z) + shift, 0, 0, 0, {}});
+    out.push_back({Eigen::Vector3f(10.0f, y, z) + shift, 0, 0, 0, {}});
     // Only the half of the pillar seen from the west.
     const double a = std::numbers::pi / 2 + std::numbers::pi * i / 400.0;
     out.push_back({Eigen::Vector3f(static_cast<float>(5.0 + 0.3 * std::cos(a)),
                                    static_cast<float>(0.3 * std::sin(a)), z) +
                        shift,
-                   0, 0, 0});
+                   0,
+                   0,
+                   0,
+                   {}});
   }
   return out;
 }
@@ -84,8 +87,11 @@ TEST(CloudEval, EndWallIsProbedOnlyInsideItsIntervals) {
     }
   }
   for (int i = 0; i < 2000; ++i) {  // the shelf face: many points, all 5 cm off the wall
-    pts.push_back(
-        {Eigen::Vector3f(9.95f, -0.4f + 0.8f * static_cast<float>(i) / 2000.0f, 1.0f), 0, 0, 0});
+    pts.push_back({Eigen::Vector3f(9.95f, -0.4f + 0.8f * static_cast<float>(i) / 2000.0f, 1.0f),
+                   0,
+                   0,
+                   0,
+                   {}});
   }
   CloudEvalConfig config;
   config.corridors = {{"main", {"x", 0.0, {{-1.5, 1.5}}}, {"x", 10.0, {{-1.5, -0.5}, {0.5, 1.5}}}}};

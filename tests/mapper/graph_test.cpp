@@ -251,6 +251,50 @@ TEST_P(GraphTest, ExportsReadBackThroughThePlyReaderAndOctoMapsOwnTool) {
   }
 }
 
+// The annotator's colours in the export: each point takes the level and colour of the key pose
+// nearest in time, and the newest annotation of a key pose wins (a loop closure recolours).
+TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
+  drive(100, true);
+  auto annotate = [&](const std::vector<int>& ids, int8_t level, uint8_t red, uint8_t green) {
+    annotations_t msg{};
+    msg.utime = kT0 + ids.back() * kKeyEvery * kPoseDt;
+    msg.parts = 1;
+    for (int k : ids) {
+      key_annotation_t a{};
+      a.utime = kT0 + k * kKeyEvery * kPoseDt;
+      a.id = k;
+      a.level = level;
+      a.rgb[0] = red;
+      a.rgb[1] = green;
+      msg.keys.push_back(a);
+    }
+    msg.n_keys = static_cast<int32_t>(msg.keys.size());
+    bus_.publish(channels::kAnnotations, msg);
+    handle_all();
+  };
+  annotate({0, 1, 2, 3, 4, 5, 6}, 1, 0, 255);
+  annotate({0, 1}, 4, 255, 0);  // the first two key poses turn red
+  std::string error;
+  ASSERT_TRUE(mapper_->export_all(&error)) << error;
+  auto cloud = mapper::read_ply((out_dir_ / "cloud.ply").string(), &error);
+  ASSERT_TRUE(cloud) << error;
+  ASSERT_GT(cloud->size(), 100u);
+  int red = 0, green = 0;
+  for (const mapper::CloudPoint& p : *cloud) {
+    // Nearest key pose by time: key k covers times within half a key interval of it.
+    const double k = static_cast<double>(p.utime - kT0) / (kKeyEvery * kPoseDt);
+    const bool near_first_two = k <= 1.5;  // a tie goes to the earlier key pose
+    EXPECT_EQ(p.colour.level, near_first_two ? 4 : 1) << k;
+    EXPECT_EQ(p.colour.rgb[0], near_first_two ? 255 : 0) << k;
+    (near_first_two ? red : green)++;
+  }
+  EXPECT_GT(red, 0);
+  EXPECT_GT(green, red);
+  mapper_->report_counters();
+  EXPECT_EQ(mapper_counters_.at("annotation_level_changes"), 2.0);
+  EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 7.0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "worker" : "inline"; });
 

@@ -1,0 +1,77 @@
+// Adapts LCM messages to the Annotator: the backend's pose-graph edges (pose_graph_edges_t on
+// POSE_GRAPH_EDGES) and key poses with marginals (key_poses_t on KEY_POSES, incremental, in parts)
+// in; after the last part of each optimisation, the annotations that are new or changed out
+// (annotations_t on ANNOTATIONS, with the legend, in parts of at most max_keys_per_message). At
+// the end of data every annotation is sent once more (REASON_FINAL), so a late listener or the
+// recorded log's last word holds them all.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "annotator.hpp"
+#include "bus.hpp"
+#include "channels.hpp"
+#include "traverse/annotations_t.hpp"
+#include "traverse/key_poses_t.hpp"
+#include "traverse/pose_graph_edges_t.hpp"
+
+namespace traverse::annotator {
+
+struct AnnotatorNodeConfig {
+  std::string key_poses_channel = channels::kKeyPoses;
+  std::string edges_channel = channels::kPoseGraphEdges;
+  std::string annotations_channel = channels::kAnnotations;
+  int max_keys_per_message = 1000;  // 52 bytes each: a part stays under 64 KB
+  AnnotatorConfig annotator;        // its keys sit at the top level of the file
+
+  template <class V>
+  void visit(V& v) {
+    v("key_poses_channel", key_poses_channel);
+    v("edges_channel", edges_channel);
+    v("annotations_channel", annotations_channel);
+    v("max_keys_per_message", max_keys_per_message);
+    annotator.visit(v);
+  }
+};
+
+// The first value out of range, named by its key; nullopt when the config is usable.
+std::optional<std::string> validate(const AnnotatorNodeConfig& config);
+
+// The messages that carry `annotations` (at most `per_message` each) with the legend; sets
+// everything but seq.
+std::vector<annotations_t> pack_annotations(const Annotator& annotator,
+                                            const std::vector<Annotation>& annotations,
+                                            int64_t utime, int32_t optimisation, int8_t reason,
+                                            int32_t loop_closures, int32_t changed_level,
+                                            int per_message);
+
+class AnnotatorNode {
+ public:
+  using CounterSink = std::function<void(const std::string& name, double value)>;
+  // The config must pass validate().
+  AnnotatorNode(Bus& bus, const AnnotatorNodeConfig& config, CounterSink counters = {});
+  // End of data: publishes every annotation once more.
+  void finish();
+  void report_counters();
+  const Annotator& annotator() const { return annotator_; }
+
+ private:
+  void on_edges(const pose_graph_edges_t& msg);
+  void on_key_poses(const key_poses_t& msg);
+  void publish(const std::vector<Annotation>& annotations, int8_t reason, int32_t changed_level);
+
+  Bus& bus_;
+  AnnotatorNodeConfig config_;
+  Annotator annotator_;
+  CounterSink counters_;
+  int64_t utime_ = 0;          // [us] newest key pose time heard
+  int32_t optimisation_ = 0;   // newest optimisation heard
+  int32_t loop_closures_ = 0;  // loop closures in the graph
+  bool closure_pending_ = false;
+  double messages_ = 0, updates_ = 0, update_s_total_ = 0, update_s_max_ = 0;
+};
+
+}  // namespace traverse::annotator

@@ -1,0 +1,59 @@
+#include "frontend_chain.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+namespace traverse::backend {
+namespace {
+
+// Rotates the (x, y) part of a covariance by theta.
+Eigen::Matrix3d rotated(const Eigen::Matrix3d& C, double theta) {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R.topLeftCorner<2, 2>() = Pose2(0.0, 0.0, theta).rotation();
+  return R * C * R.transpose();
+}
+
+// Below this travel a step still drifts as much as this [m]: a standstill keeps a finite
+// information.
+constexpr double kMinDriftTravelM = 0.01;
+
+}  // namespace
+
+Eigen::Matrix3d frontend_pose_covariance(const PreparedPose& pose, double scale,
+                                         const Eigen::Matrix3d& fallback) {
+  const Eigen::Matrix3d& C = pose.frontend.covariance;
+  if (C.isZero() || !C.allFinite() || !(C.diagonal().array() > 0.0).all()) return fallback;
+  // Map frame -> world (prepared) frame -> the pose's own frame.
+  return scale * rotated(C, -pose.frontend.T_map_base.theta());
+}
+
+Edge drift_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
+                const Eigen::Matrix3d& ca, const Eigen::Matrix3d& cb, double drift_length_m) {
+  Edge edge;
+  edge.from = from;
+  edge.to = to;
+  edge.T_from_to = between(a.T_world_base, b.T_world_base);
+  const double travel = std::max(
+      kMinDriftTravelM, b.travel_m - a.travel_m + kTurnLeverM * std::abs(edge.T_from_to.theta()));
+  edge.information = (travel / drift_length_m * 0.5 * (ca + cb)).inverse();
+  return edge;
+}
+
+Edge motion_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
+                 const Eigen::Matrix3d& ca, const Eigen::Matrix3d& cb) {
+  Edge edge;
+  edge.from = from;
+  edge.to = to;
+  edge.T_from_to = between(a.T_world_base, b.T_world_base);
+  // Each pose's error carried through the relative pose: J_a C_a J_a^T + J_b C_b J_b^T with the
+  // edge error's Jacobians (pose_graph.hpp), the covariances turned back into the world frame.
+  Eigen::Matrix3d J_a, J_b;
+  edge_jacobians(a.T_world_base, b.T_world_base, edge.T_from_to, J_a, J_b);
+  const Eigen::Matrix3d Ca = rotated(ca, a.T_world_base.theta());
+  const Eigen::Matrix3d Cb = rotated(cb, b.T_world_base.theta());
+  edge.information = (J_a * Ca * J_a.transpose() + J_b * Cb * J_b.transpose()).inverse();
+  return edge;
+}
+
+}  // namespace traverse::backend

@@ -1,0 +1,80 @@
+#include "odometry_check.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "config.hpp"
+
+namespace traverse::backend {
+
+std::optional<std::string> validate(const OdometryCheckConfig& c) {
+  ConfigCheck check;
+  check.positive("min_sigma_xy_m", c.min_sigma_xy_m);
+  check.not_negative("sigma_xy_per_m", c.sigma_xy_per_m);
+  check.positive("min_sigma_theta_rad", c.min_sigma_theta_rad);
+  check.not_negative("sigma_theta_per_m", c.sigma_theta_per_m);
+  check.not_negative("sigma_theta_per_rad", c.sigma_theta_per_rad);
+  check.positive("max_frontend_chi2", c.max_frontend_chi2);
+  check.positive("max_reading_gap_us", c.max_reading_gap_us);
+  check.positive("keep_us", c.keep_us);
+  return check.problem();
+}
+
+void OdometryCheck::add(int64_t utime, const Pose2& T_odom_base) {
+  if (!config_.enabled) return;
+  if (!readings_.empty() && utime <= readings_.back().first) {
+    ++counters_.readings_out_of_order;
+    return;
+  }
+  ++counters_.readings;
+  readings_.emplace_back(utime, T_odom_base);
+  while (readings_.front().first < utime - config_.keep_us) readings_.pop_front();
+}
+
+std::optional<Pose2> OdometryCheck::at(int64_t utime) const {
+  const auto later =
+      std::lower_bound(readings_.begin(), readings_.end(), utime,
+                       [](const std::pair<int64_t, Pose2>& r, int64_t t) { return r.first < t; });
+  const int64_t gap = config_.max_reading_gap_us;
+  if (later != readings_.end() && later->first == utime) return later->second;
+  if (later == readings_.begin()) {
+    if (later != readings_.end() && later->first - utime <= gap) return later->second;
+    return std::nullopt;
+  }
+  const auto earlier = std::prev(later);
+  if (later == readings_.end()) {
+    if (utime - earlier->first <= gap) return earlier->second;
+    return std::nullopt;
+  }
+  if (later->first - earlier->first > 2 * gap) return std::nullopt;
+  const double s = static_cast<double>(utime - earlier->first) /
+                   static_cast<double>(later->first - earlier->first);
+  return interpolate(earlier->second, later->second, s);
+}
+
+std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utime,
+                                                 const Pose2& frontend_motion,
+                                                 const Eigen::Matrix3d& frontend_covariance) {
+  if (!config_.enabled) return std::nullopt;
+  const std::optional<Pose2> a = at(a_utime), b = at(b_utime);
+  if (!a || !b) return std::nullopt;
+  ++counters_.steps_checked;
+  OdometryStep step;
+  step.motion = between(*a, *b);
+  const double d = step.motion.translation().norm();
+  const double sxy = config_.min_sigma_xy_m + config_.sigma_xy_per_m * d;
+  const double sth = config_.min_sigma_theta_rad + config_.sigma_theta_per_m * d +
+                     config_.sigma_theta_per_rad * std::abs(step.motion.theta());
+  step.covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
+  const Eigen::Vector3d e(frontend_motion.x() - step.motion.x(),
+                          frontend_motion.y() - step.motion.y(),
+                          wrap_angle(frontend_motion.theta() - step.motion.theta()));
+  const Eigen::Matrix3d S = step.covariance + frontend_covariance;
+  step.frontend_chi2 = e.dot(S.ldlt().solve(e));
+  step.frontend_rejected = !(step.frontend_chi2 <= config_.max_frontend_chi2);
+  if (step.frontend_rejected) ++counters_.steps_contradicted;
+  return step;
+}
+
+}  // namespace traverse::backend

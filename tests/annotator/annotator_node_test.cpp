@@ -1,0 +1,187 @@
+// The annotator behind the backend on memq://: the graph the annotator rebuilds from
+// POSE_GRAPH_EDGES and KEY_POSES gives the backend's own marginals (so no edge is missing), the
+// annotations carry the legend, and a loop closure lowers the bounds near it and changes colours.
+#include "annotator_node.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <map>
+
+#include "backend_node.hpp"
+#include "scan_message.hpp"
+#include "synthetic.hpp"
+#include "traverse/key_poses_t.hpp"
+
+namespace traverse::annotator {
+namespace {
+
+class AnnotatorNodeTest : public ::testing::Test {
+ protected:
+  // The backend's drive round an ellipse with loop closures (tests/backend_slam), both nodes on
+  // one in-process bus.
+  void run(AnnotatorNodeConfig config) {
+    backend::BackendNodeConfig backend_config;
+    backend_config.max_poses_per_message = 10;  // parts for both channels
+    backend_config.backend.frontend_sigma_xy_m = 0.015;
+    backend_config.backend.frontend_sigma_theta_rad = 0.005;
+    ASSERT_FALSE(backend::validate(backend_config));
+    ASSERT_FALSE(validate(config));
+    backend::BackendNode backend(bus_, backend_config);
+    AnnotatorNode annotator(bus_, config,
+                            [this](const std::string& k, double v) { counters_[k] = v; });
+    bus_.subscribe<annotations_t>(
+        channels::kAnnotations, [this](const annotations_t& m) { messages_.push_back(m); }, true);
+    bus_.subscribe<pose_graph_edges_t>(
+        channels::kPoseGraphEdges, [this](const pose_graph_edges_t& m) { edges_.push_back(m); },
+        true);
+    const backend::test::Drive d = backend::test::drive_ellipse(18.0);
+    for (std::size_t k = 0; k < d.utimes.size(); ++k) {
+      planar_scan_t scan =
+          to_planar_scan_message(d.scans[k], "laser_horizontal", static_cast<int64_t>(k));
+      bus_.publish(channels::kScanHorizontal, scan);
+      pose2d_t p{};
+      p.utime = d.utimes[k];
+      p.seq = static_cast<int64_t>(k);
+      p.parent_frame = "map";
+      p.child_frame = "base";
+      p.x = d.input[k].x();
+      p.y = d.input[k].y();
+      p.theta = d.input[k].theta();
+      bus_.publish(channels::kPoseFrontend, p);
+      handle_all();
+    }
+    backend.finish();
+    handle_all();
+    annotator.finish();
+    handle_all();
+    annotator.report_counters();
+    const auto& keys = backend.backend().key_poses();
+    for (const auto& k : keys) backend_marginals_.push_back(k.covariance);
+    backend_poses_ = backend.backend().graph().poses;
+    backend_edges_ = backend.backend().graph().edges.size();
+    closures_ = backend.backend().closures().size();
+  }
+  void handle_all() {
+    while (bus_.lcm().handleTimeout(0) > 0) {
+    }
+  }
+
+  Bus bus_{"memq://"};
+  std::map<std::string, double> counters_;
+  std::vector<annotations_t> messages_;
+  std::vector<pose_graph_edges_t> edges_;
+  std::vector<Eigen::Matrix3d> backend_marginals_;
+  std::vector<Pose2> backend_poses_;
+  std::size_t backend_edges_ = 0, closures_ = 0;
+};
+
+TEST_F(AnnotatorNodeTest, RebuildsTheBackendsGraphAndCoversEveryKeyPose) {
+  AnnotatorNodeConfig config;
+  run(config);
+  ASSERT_GT(closures_, 0u);
+  // Every edge once, in order, in parts of at most 10.
+  int next = 0;
+  for (const pose_graph_edges_t& m : edges_) {
+    EXPECT_LE(m.n_edges, 10);
+    EXPECT_EQ(m.first_index, next);
+    for (const pose_graph_edge_t& e : m.edges) {
+      EXPECT_EQ(e.index, next++);
+      EXPECT_EQ(e.kind == pose_graph_edge_t::KIND_LOOP_CLOSURE, e.to_id != e.from_id + 1);
+    }
+  }
+  EXPECT_EQ(next, static_cast<int>(backend_edges_));
+  EXPECT_EQ(counters_.at("edges"), static_cast<double>(backend_edges_));
+  EXPECT_EQ(counters_.at("edges_missed"), 0.0);
+  EXPECT_EQ(counters_.at("local_failed"), 0.0);
+  // The last message (end of data) holds every key pose, with the legend.
+  const annotations_t& last = messages_.back();
+  EXPECT_EQ(last.reason, static_cast<int8_t>(annotations_t::REASON_FINAL));
+  EXPECT_EQ(last.standard, "USIBD LOA");
+  ASSERT_EQ(last.n_levels, 5);
+  EXPECT_EQ(last.levels[0].name, "LOA50");
+  EXPECT_EQ(last.coloured_by, "absolute");
+  EXPECT_EQ(last.bound_method, "exact");
+  EXPECT_DOUBLE_EQ(last.confidence, 0.95);
+  std::size_t keys = 0;
+  for (auto it = messages_.rbegin(); it != messages_.rend() && it->reason == last.reason; ++it) {
+    keys += it->keys.size();
+  }
+  EXPECT_EQ(keys, backend_marginals_.size());
+  for (const annotations_t& m : messages_) {
+    for (const key_annotation_t& k : m.keys) {
+      ASSERT_GE(k.level, 0);
+      ASSERT_LT(k.level, m.n_levels);
+      EXPECT_EQ(k.rgb[0], m.levels[k.level].rgb[0]);
+      EXPECT_EQ(k.rgb[1], m.levels[k.level].rgb[1]);
+      EXPECT_GE(k.local_bound_m, 0.0);
+    }
+  }
+}
+
+TEST_F(AnnotatorNodeTest, EdgeMessagesRebuildTheBackendsInformationMatrix) {
+  // With the paper's bound the absolute bound is 2 sqrt(lambda_max) of the marginal as last sent.
+  AnnotatorNodeConfig config;
+  config.annotator.bound = "paper";
+  config.annotator.republish_fraction = 0.0;
+  run(config);
+  // The graph from the edge messages at the backend's final poses: the backend's own marginals.
+  backend::PoseGraph graph;
+  for (std::size_t i = 0; i < backend_poses_.size(); ++i) {
+    graph.add_vertex(static_cast<int64_t>(i), backend_poses_[i], i == 0);
+  }
+  for (const pose_graph_edges_t& m : edges_) {
+    for (const pose_graph_edge_t& e : m.edges) {
+      backend::Edge edge;
+      edge.from = static_cast<int>(e.from_id);
+      edge.to = static_cast<int>(e.to_id);
+      edge.T_from_to = Pose2(e.x, e.y, e.theta);
+      for (int k = 0; k < 9; ++k) edge.information(k / 3, k % 3) = e.information[k];
+      graph.edges.push_back(edge);
+    }
+  }
+  JointCovariance joint;
+  ASSERT_TRUE(joint.factor(graph));
+  std::map<int64_t, double> bound;
+  for (const annotations_t& m : messages_) {
+    for (const key_annotation_t& k : m.keys) bound[k.id] = k.bound_m;
+  }
+  ASSERT_EQ(bound.size(), backend_marginals_.size());
+  for (std::size_t i = 1; i < backend_marginals_.size(); ++i) {
+    EXPECT_TRUE(joint.marginal(static_cast<int>(i)).isApprox(backend_marginals_[i], 1e-6)) << i;
+    // The backend resends a key pose when a variance changed by 1 % (backend_node.hpp).
+    const Eigen::Matrix2d c = backend_marginals_[i].topLeftCorner<2, 2>();
+    const double expected = 2.0 * std::sqrt(c.eigenvalues().real().maxCoeff());
+    EXPECT_NEAR(bound[static_cast<int64_t>(i)], expected, 0.01 * expected) << i;
+  }
+}
+
+TEST_F(AnnotatorNodeTest, LoopClosureLowersBoundsAndChangesColours) {
+  AnnotatorNodeConfig config;
+  // Levels 15 mm apart so that this short drive (bounds of 20 to 70 mm) spans several of them.
+  config.annotator.limits_m = {0.015, 0.03, 0.045, 0.06};
+  config.annotator.best_level = "LOA40";
+  config.annotator.worst_level = "LOA10";
+  run(config);
+  std::map<int64_t, key_annotation_t> now;
+  int closure_messages = 0, lowered = 0, recoloured = 0;
+  for (const annotations_t& m : messages_) {
+    if (m.reason == annotations_t::REASON_LOOP_CLOSURE) {
+      ++closure_messages;
+      for (const key_annotation_t& k : m.keys) {
+        auto it = now.find(k.id);
+        if (it == now.end()) continue;
+        if (k.bound_m < it->second.bound_m) ++lowered;
+        if (k.level < it->second.level && k.rgb[1] > it->second.rgb[1]) ++recoloured;
+      }
+    }
+    for (const key_annotation_t& k : m.keys) now[k.id] = k;
+  }
+  EXPECT_GT(closure_messages, 0);
+  EXPECT_GT(lowered, 5);
+  EXPECT_GT(recoloured, 0);  // greener after the closure
+  EXPECT_GT(counters_.at("level_changes"), 0.0);
+}
+
+}  // namespace
+}  // namespace traverse::annotator
