@@ -1,4 +1,5 @@
-// Binary PLY (little endian) for the mapper's cloud: x, y, z [m, float32] in the world frame,
+// Binary PLY (little endian) for the mapper's cloud: x, y, z [m, float32] in the map frame (the
+// base at the first scan, or the frontend's initial_pose; traverse-export writes other frames),
 // intensity [0..255, uchar], time [s since the Unix epoch, float64], key_id [int32, the key pose
 // whose segment placed the point]. Opens in CloudCompare and other PLY readers; the reader below
 // reads back exactly this layout (for the evaluation tools).
