@@ -35,3 +35,42 @@ add_dependencies(traverse_lcmtypes lcmtypes_gen)
 target_include_directories(traverse_lcmtypes SYSTEM PUBLIC ${LCM_OUT})
 target_include_directories(traverse_lcmtypes PRIVATE ${CMAKE_SOURCE_DIR}/common)
 target_link_libraries(traverse_lcmtypes PUBLIC lcm::lcm)
+
+# The same types for Python (build/python/traverse/, for analysis scripts: LCM 1.3.1 in Debian has
+# no Python module, scripts/lcmlog.py reads logs) and Java (build/java/traverse-lcmtypes.jar, for
+# lcm-spy: scripts/spy.sh), so that every tool decodes every channel.
+set(LCM_PY_OUT ${CMAKE_BINARY_DIR}/python)
+set(LCM_PY_FILES "")
+foreach(f ${LCM_FILES})
+  get_filename_component(type ${f} NAME_WE)
+  list(APPEND LCM_PY_FILES ${LCM_PY_OUT}/traverse/${type}.py)
+endforeach()
+add_custom_command(
+  OUTPUT ${LCM_PY_FILES}
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${LCM_PY_OUT}
+  COMMAND ${LCM_GEN} --python --ppath ${LCM_PY_OUT} ${LCM_FILES}
+  DEPENDS ${LCM_FILES}
+  COMMENT "lcm-gen: generating Python message types")
+add_custom_target(lcmtypes_python ALL DEPENDS ${LCM_PY_FILES})
+
+find_package(Java COMPONENTS Development)
+find_file(LCM_JAR lcm.jar PATHS /usr/share/java /usr/local/share/java)
+if(Java_FOUND AND LCM_JAR)
+  include(UseJava)
+  set(LCM_JAVA_SRC ${CMAKE_BINARY_DIR}/java/src)
+  set(LCM_JAVA_FILES "")
+  foreach(f ${LCM_FILES})
+    get_filename_component(type ${f} NAME_WE)
+    list(APPEND LCM_JAVA_FILES ${LCM_JAVA_SRC}/traverse/${type}.java)
+  endforeach()
+  add_custom_command(
+    OUTPUT ${LCM_JAVA_FILES}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${LCM_JAVA_SRC}
+    COMMAND ${LCM_GEN} --java --jpath ${LCM_JAVA_SRC} ${LCM_FILES}
+    DEPENDS ${LCM_FILES}
+    COMMENT "lcm-gen: generating Java message types")
+  add_jar(traverse_lcmtypes_java SOURCES ${LCM_JAVA_FILES} INCLUDE_JARS ${LCM_JAR}
+    OUTPUT_NAME traverse-lcmtypes OUTPUT_DIR ${CMAKE_BINARY_DIR}/java)
+else()
+  message(STATUS "No Java compiler or lcm.jar (liblcm-java): no Java message types, no lcm-spy")
+endif()
