@@ -27,6 +27,7 @@
 #include "launch_report.hpp"
 #include "run_checks.hpp"
 #include "supervisor.hpp"
+#include "version.hpp"
 
 namespace fs = std::filesystem;
 using traverse::launch::Supervisor;
@@ -222,6 +223,7 @@ int main(int argc, char** argv) {
       "traverse-launch");
   Options o;
   add_options(app, o);
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   traverse::launch::Deployment deployment;
