@@ -5,7 +5,9 @@ json), never with sed or awk.
   conf.py get FILE PATH            the value at PATH: a scalar as text (true/false, numbers as
                                    written), a list or mapping as JSON; exit 1 when absent
   conf.py set FILE PATH VALUE      FILE as YAML on stdout with PATH set to VALUE (read as YAML);
-                                   exit 1 when PATH is absent (a key is never invented)
+                                   missing mapping keys on the way are added (a config lists
+                                   only what a deployment sets; the program refuses a key it does
+                                   not know, naming it); a list element must exist
   conf.py merge ITEM...            one JSON object on stdout: each ITEM a JSON object (text, or
                                    @FILE for the last line of a file), merged in order; KEY=ITEM
                                    puts ITEM's object under KEY; an empty ITEM is skipped
@@ -36,12 +38,17 @@ def child(node, part):
     return node, part, False
 
 
-def walk(doc, path):
-    """(container, key) of PATH's last part; SystemExit(1) when a part is absent."""
+def walk(doc, path, create=False):
+    """(container, key) of PATH's last part; SystemExit(1) when a part is absent (with `create`,
+    absent mapping keys are added)."""
     node = doc
     parts = path.split(".")
     for n, part in enumerate(parts):
         container, key, present = child(node, part)
+        if not present and create and isinstance(container, dict):
+            if n < len(parts) - 1:
+                container[key] = {}
+            present = True
         if not present:
             sys.exit(f"conf.py: no '{'.'.join(parts[:n + 1])}'")
         if n == len(parts) - 1:
@@ -77,8 +84,8 @@ def main(argv):
         container, key = walk(load(argv[1]), argv[2])
         print(text(container[key]))
     elif len(argv) == 4 and argv[0] == "set":
-        doc = load(argv[1])
-        container, key = walk(doc, argv[2])
+        doc = load(argv[1]) or {}
+        container, key = walk(doc, argv[2], create=True)
         container[key] = yaml.safe_load(argv[3])
         sys.stdout.write(yaml.safe_dump(doc, sort_keys=False))
     elif argv and argv[0] == "merge":

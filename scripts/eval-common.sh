@@ -8,6 +8,9 @@ GRAPH_JSON=""  # run-graph's JSON line, merged into the output under "graph"
 # Programs come from build/bin (scripts/setup.sh builds it when it is missing); TRAVERSE_BIN_DIR
 # points elsewhere, e.g. at another build tree.
 BIN="${TRAVERSE_BIN_DIR:-$ROOT/build/bin}"
+# Debian's interpreter first: the one python3-yaml (scripts/conf.py) installs into.
+PYTHON=/usr/bin/python3
+[[ -x $PYTHON ]] || PYTHON=python3
 
 die() {
   echo "$(basename "$0"): $*" >&2
@@ -105,12 +108,12 @@ run_graph() {
   [[ -x $ROOT/scripts/run-graph.sh ]] || die "scripts/run-graph.sh not found"
   local rc=0 deploy="$ROOT/configs/deploy/pipeline.yaml"
   if [[ -n ${DESKEW_OFF:-} ]]; then
-    python3 "$ROOT/scripts/conf.py" set "$ROOT/configs/frontend.yaml" deskew.enabled false \
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$ROOT/configs/frontend.yaml" deskew.enabled false \
       >"$out/frontend-deskew-off.yaml" ||
       die "configs/frontend.yaml has no deskew.enabled to switch off"
-    [[ $(python3 "$ROOT/scripts/conf.py" get "$deploy" processes.frontend.config) == configs/frontend.yaml ]] ||
+    [[ $("$PYTHON" "$ROOT/scripts/conf.py" get "$deploy" processes.frontend.config) == configs/frontend.yaml ]] ||
       die "configs/deploy/pipeline.yaml does not run the frontend with configs/frontend.yaml"
-    python3 "$ROOT/scripts/conf.py" set "$deploy" processes.frontend.config \
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$deploy" processes.frontend.config \
       "$out/frontend-deskew-off.yaml" >"$out/pipeline-deskew-off.yaml"
     deploy="$out/pipeline-deskew-off.yaml"
   fi
@@ -209,7 +212,7 @@ cloud_evaluate() {
 # evaluation's fields (when the mapper ran) after it, and the graph's JSON (when run-graph printed
 # one) under "graph".
 merged_json() {
-  python3 "$ROOT/scripts/conf.py" merge "{$1}" "$EVAL_JSON" "${CLOUD_JSON:-}" \
+  "$PYTHON" "$ROOT/scripts/conf.py" merge "{$1}" "$EVAL_JSON" "${CLOUD_JSON:-}" \
     ${GRAPH_JSON:+graph="$GRAPH_JSON"}
 }
 

@@ -43,14 +43,10 @@ done
 need_programs traverse-frontend traverse-evaluator
 # The log converted (cached) by scripts/eval-carmen.sh, whose JSON names it and the log's name.
 converted="$("$ROOT/scripts/eval-carmen.sh" "$what" | tail -n 1)"
-name="$(python3 "$ROOT/scripts/conf.py" get - carmen <<<"$converted")" || name=""
-cache="$(python3 "$ROOT/scripts/conf.py" get - lcm_log <<<"$converted")" || cache=""
+name="$("$PYTHON" "$ROOT/scripts/conf.py" get - carmen <<<"$converted")" || name=""
+cache="$("$PYTHON" "$ROOT/scripts/conf.py" get - lcm_log <<<"$converted")" || cache=""
 [[ -n $name && -s $cache ]] || die "scripts/eval-carmen.sh $what named no converted log"
-conf() { python3 "$ROOT/scripts/conf.py" "$@"; }
-conf get "$ROOT/configs/frontend.yaml" initial_pose >/dev/null ||
-  die "configs/frontend.yaml has no top-level 'initial_pose' to replace"
-conf get "$ROOT/configs/frontend.yaml" matcher.sparse_ensemble_members >/dev/null ||
-  die "configs/frontend.yaml has no 'matcher: sparse_ensemble_members' to replace"
+conf() { "$PYTHON" "$ROOT/scripts/conf.py" "$@"; }
 
 out="$ROOT/out/sensitivity/carmen-$name${members:+-members$members}"
 rm -rf "$out"
@@ -66,10 +62,12 @@ for ((i = 0; i < starts; i++)); do
            (i == 0 ? 0 : (2 * (h - int(h)) - 1) * 3.14159265358979 / 180) }')
   dir="$out/start-$i"
   mkdir -p "$dir"
-  conf set "$ROOT/configs/frontend.yaml" initial_pose "{x_m: $x, y_m: $y, theta_rad: $theta}" |
-    conf set - matcher.sparse_ensemble_members \
-      "${members:-$(conf get "$ROOT/configs/frontend.yaml" matcher.sparse_ensemble_members)}" \
-      >"$dir/frontend.yaml"
+  conf set "$ROOT/configs/frontend.yaml" initial_pose "{x_m: $x, y_m: $y, theta_rad: $theta}" \
+    >"$dir/frontend.yaml"
+  if [[ -n $members ]]; then
+    conf set "$dir/frontend.yaml" matcher.sparse_ensemble_members "$members" >"$dir/frontend.tmp"
+    mv "$dir/frontend.tmp" "$dir/frontend.yaml"
+  fi
   "$BIN/traverse-frontend" --config "$dir/frontend.yaml" --replay "$cache" \
     --record "$dir/run.lcmlog" >"$dir/frontend.out" 2>&1 ||
     die "traverse-frontend failed on start $i, see $dir/frontend.out"
@@ -90,6 +88,7 @@ read -r median worst over < <(printf '%s\n' "${jumps[@]}" | sort -g | awk '
   { v[NR] = $1; if ($1 > 0.5) n++ }
   END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%.6f %.6f %d\n", m, v[NR], n }')
 rpe10_worst="$(printf '%s\n' "${rpe10s[@]}" | sort -g | tail -n 1)"
-members_used="$(conf get "$out/start-0/frontend.yaml" matcher.sparse_ensemble_members)"
+members_used="$(conf get "$out/start-0/frontend.yaml" matcher.sparse_ensemble_members 2>/dev/null)" ||
+  members_used="null"  # the frontend's default (frontend_config.hpp)
 echo "frontend-sensitivity: $name, $starts starts, $members_used-member ensemble: largest jump median $median m, worst $worst m, $over starts over 0.5 m; rpe over 10 m worst $rpe10_worst m; outputs in $out" >&2
 echo "{\"carmen\": $(json_str "$name"), \"starts\": $starts, \"sparse_ensemble_members\": $members_used, \"max_jump_median_m\": $median, \"max_jump_worst_m\": $worst, \"starts_over_0_5_m\": $over, \"rpe_10m_worst_m\": $rpe10_worst, \"runs\": [$runs], \"out_dir\": $(json_str "$out")}"
