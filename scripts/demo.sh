@@ -123,12 +123,13 @@ for f in monitor.json errors.png; do
   [[ -e $run_dir/$f ]] && mv "$run_dir/$f" "$out/$f"
 done
 rm -f "$out"/map.bt "$out"/map.ot "$out"/cloud.ply "$out"/cloud.las "$out"/run.lcmlog
-cloud=()
+export_args=(--reference POSE_GROUND_TRUTH)
+[[ -n $carmen ]] && export_args=(--reference POSE_REFERENCE)
 if [[ -f $run_dir/mapper/cloud.ply ]]; then
   mv "$run_dir/mapper/map.bt" "$run_dir/mapper/map.ot" "$out/"
-  cloud=(--cloud "$run_dir/mapper/cloud.ply")
+  export_args+=(--cloud "$run_dir/mapper/cloud.ply")
 fi
-"$ROOT/build/bin/traverse-export" --log "$run_dir/run.lcmlog" "${cloud[@]}" --out "$out" \
+"$ROOT/build/bin/traverse-export" --log "$run_dir/run.lcmlog" "${export_args[@]}" --out "$out" \
   --frame "$frame" --thin "$thin" >"$logs/export.out" 2>"$logs/export.log" ||
   { cat "$logs/export.log" >&2; die "traverse-export failed"; }
 mv "$out/export.json" "$logs/export.json"

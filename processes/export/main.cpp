@@ -3,7 +3,7 @@
 // cloud.ply it writes, in the frame asked for:
 //   trajectory.tum  the final dense trajectory in TUM format (evo and others read it)
 //   trajectory.csv  the same with each pose's covariance, 95 % bound and level of accuracy
-//   ground_truth.tum  the simulator's ground truth (when the run has it)
+//   ground_truth.tum  the simulator's ground truth (reference.tum: a CARMEN log's reference poses)
 //   cloud.las       LAS 1.4 (format 7: GPS time, intensity, accuracy colour as RGB; extra bytes
 //                   loa_level, bound95_m, key_id), cloud.ply the same as binary PLY
 // and prints one JSON summary line last.
@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
       "colours) in the map frame or the simulator's world frame",
       "traverse-export");
   traverse::add_version_flag(app);
-  std::string log, cloud, out = ".", frame = "map";
+  std::string log, cloud, out = ".", frame = "map", reference = "POSE_GROUND_TRUTH";
   int thin = 1, top = 40, bottom = 20;
   bool no_cloud_ply = false;
   app.add_option("--log", log, "recorded run (LCM log with KEY_POSES, DENSE_SEGMENTS)")
@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
                  "map (the estimate's own frame) or world (tied to the simulator's ground truth "
                  "at the first pose)")
       ->check(CLI::IsMember({"map", "world"}))
+      ->capture_default_str();
+  app.add_option("--reference", reference,
+                 "channel of the reference poses: the simulator's POSE_GROUND_TRUTH, or a CARMEN "
+                 "log's POSE_REFERENCE (written as ground_truth.tum or reference.tum)")
       ->capture_default_str();
   app.add_option("--thin", thin, "keep every n-th point of the cloud")
       ->check(CLI::PositiveNumber)
@@ -59,7 +63,7 @@ int main(int argc, char** argv) {
 
   ex::RunEstimate run;
   try {
-    run = ex::read_run(log);
+    run = ex::read_run(log, reference);
   } catch (const std::exception& e) {
     std::cerr << "traverse-export: " << e.what() << "\n";
     return 1;
@@ -74,9 +78,8 @@ int main(int argc, char** argv) {
   const std::optional<traverse::Pose2> T_world_map = ex::world_from_map(run, dense);
   if (frame == "world") {
     if (!T_world_map) {
-      std::cerr << "traverse-export: --frame world needs POSE_GROUND_TRUTH covering the first "
-                   "pose (a simulated run); "
-                << log << " has none\n";
+      std::cerr << "traverse-export: --frame world needs " << reference
+                << " covering the first pose; " << log << " has none\n";
       return 1;
     }
     T_out_map = *T_world_map;
@@ -120,8 +123,10 @@ int main(int argc, char** argv) {
       g.pose = T_frame_world * pose;
       gt.push_back(g);
     }
-    ok = ok && ex::write_tum((dir / "ground_truth.tum").string(), gt, frame);
-    files["ground_truth_tum"] = file_entry(dir / "ground_truth.tum");
+    const std::string name =
+        reference == "POSE_GROUND_TRUTH" ? "ground_truth.tum" : "reference.tum";
+    ok = ok && ex::write_tum((dir / name).string(), gt, frame);
+    files[name == "reference.tum" ? "reference_tum" : "ground_truth_tum"] = file_entry(dir / name);
   }
   if (!ok) {
     std::cerr << "traverse-export: cannot write the trajectories into " << out << "\n";

@@ -30,7 +30,7 @@ Eigen::Matrix3d row_major(const double* c) {
 
 }  // namespace
 
-RunEstimate read_run(const std::string& log_path) {
+RunEstimate read_run(const std::string& log_path, const std::string& reference_channel) {
   RunEstimate run;
   LogReader reader(log_path);
   while (auto ev = reader.next()) {
@@ -57,7 +57,7 @@ RunEstimate read_run(const std::string& log_path) {
         for (int i = 0; i < s.n_poses; ++i) seg.poses.emplace_back(s.x[i], s.y[i], s.theta[i]);
         run.segments[s.key_id_first] = std::move(seg);
       }
-    } else if (ev->channel == channels::kPoseGroundTruth) {
+    } else if (ev->channel == reference_channel) {
       pose2d_t m;
       if (!decode(ev->data, m)) {
         ++run.decode_failures;

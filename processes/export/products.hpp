@@ -50,13 +50,15 @@ struct Segment {
 struct RunEstimate {
   std::map<int64_t, KeyPose> key_poses;  // newest per id (KEY_POSES)
   std::map<int64_t, Segment> segments;   // newest revision per key_id_first (DENSE_SEGMENTS)
-  std::vector<std::pair<int64_t, Pose2>> ground_truth;  // T_world_base (POSE_GROUND_TRUTH)
+  std::vector<std::pair<int64_t, Pose2>> ground_truth;  // T_world_base (the reference channel)
   int64_t events = 0, damaged_records = 0, decode_failures = 0;
 };
 
-// Reads KEY_POSES, DENSE_SEGMENTS and POSE_GROUND_TRUTH from an LCM log (damage is skipped and
-// counted). Throws std::runtime_error if the file cannot be opened.
-RunEstimate read_run(const std::string& log_path);
+// Reads KEY_POSES, DENSE_SEGMENTS and the reference (POSE_GROUND_TRUTH, or a CARMEN log's
+// POSE_REFERENCE) from an LCM log (damage is skipped and counted). Throws std::runtime_error if
+// the file cannot be opened.
+RunEstimate read_run(const std::string& log_path,
+                     const std::string& reference_channel = "POSE_GROUND_TRUTH");
 
 // The dense trajectory in key-id order (shared segment ends once), covariances interpolated.
 std::vector<DensePose> dense_trajectory(const RunEstimate& run);
