@@ -87,6 +87,7 @@ if [[ -n $carmen ]]; then
   run_dir="$ROOT/out/eval/carmen-$name-${stages//,/+}"
   what="CARMEN log $carmen"
   total=""
+  input_stage=convert
 else
   stages=all
   dur=()
@@ -96,14 +97,16 @@ else
   run_dir="$ROOT/out/eval/$route-seed$seed${dur:+-d$duration}-$profile-all"
   what="route $route, seed $seed, $profile profile, $([[ $duration == 0 ]] && echo "whole route" || echo "first $duration s")"
   total="$([[ $duration == 0 ]] || echo "$duration")"
+  input_stage=simulate
 fi
-echo "demo: [2/4] $what: simulate, run the graph ($([[ -n $offline ]] && echo offline || echo live)), evaluate"
+echo "demo: [2/4] $what: $input_stage, run the graph ($([[ -n $offline ]] && echo offline || echo live)), evaluate"
 rm -rf "$run_dir"
 mkdir -p "$run_dir"
 "${cmd[@]}" >"$logs/eval.out" 2>"$logs/eval.log" &
 run_pid=$!
 "$PY" "$ROOT/scripts/demo_progress.py" --watch "$run_pid" --out "$run_dir" \
-  --cache "$ROOT/out/cache" --log "$logs/eval.log" ${total:+--total "$total"} &
+  --cache "$ROOT/out/cache" --log "$logs/eval.log" --input-stage "$input_stage" \
+  ${total:+--total "$total"} &
 progress_pid=$!
 rc=0
 wait "$run_pid" || rc=$?

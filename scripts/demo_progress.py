@@ -2,7 +2,7 @@
 """Progress of a demo run, read from the files the run is writing (scripts/demo.sh starts it):
 which stage works, how many seconds of data it has done out of how many, and at what rate
 (seconds of data per second of wall time). The stages' files:
-  out/cache/*.lcmlog.tmp           the simulator writing its log (stage "simulate")
+  out/cache/*.lcmlog.tmp           the simulator (or the CARMEN driver) writing the input log
   OUT/<stage>.lcmlog               an offline stage's record (each event stamped with data time)
   OUT/run.lcmlog                   the live graph's recording: the frontend's newest pose time
                                    against the first scan's
@@ -86,6 +86,7 @@ def main():
     ap.add_argument("--total", type=float)
     ap.add_argument("--log")
     ap.add_argument("--every", type=float, default=10.0)
+    ap.add_argument("--input-stage", default="simulate", help="name of the stage writing the input log")
     a = ap.parse_args()
     start = time.monotonic()
     watched = {}
@@ -96,12 +97,12 @@ def main():
         if path and path not in watched and os.path.getmtime(path) >= time.time() - 60:
             name = os.path.basename(path)
             if name.endswith(".tmp"):
-                stage, live = "simulate", False
+                stage, live = a.input_stage, False
             elif name == "run.lcmlog":
                 stage, live = "graph (live)", True
             else:
                 stage, live = name[: -len(".lcmlog")], False
-            if not (stage == "graph (live)" and any(not w.live and w.stage != "simulate" for w in watched.values())):
+            if not (stage == "graph (live)" and any(not w.live and w.stage != a.input_stage for w in watched.values())):
                 watched[path] = Watched(path, stage, live)
         now = time.monotonic()
         after = [f for f in ("cloud-eval.out", "evaluator.out")
