@@ -17,6 +17,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <concepts>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -97,14 +98,19 @@ class Reader {
 
   template <class T>
   static const char* expected_name() {
-    if constexpr (std::is_same_v<T, bool>) return "true or false";
-    else if constexpr (std::is_integral_v<T>) return "an integer";
-    else if constexpr (std::is_floating_point_v<T>) return "a finite number";
-    else return "a string";
+    if constexpr (std::is_same_v<T, bool>)
+      return "true or false";
+    else if constexpr (std::is_integral_v<T>)
+      return "an integer";
+    else if constexpr (std::is_floating_point_v<T>)
+      return "a finite number";
+    else
+      return "a string";
   }
 
   void check_is_mapping() const;
-  [[noreturn]] void fail(const std::string& path, const char* expected, const YAML::Node& got) const;
+  [[noreturn]] void fail(const std::string& path, const char* expected,
+                         const YAML::Node& got) const;
 
   YAML::Node node_;
   std::string file_;
@@ -114,6 +120,24 @@ class Reader {
 
 YAML::Node load_file(const std::string& path);
 YAML::Node load_string(const std::string& text, const std::string& name);
+
+// Ends the ordinary look-up of `validate` here (with a function no config matches), so that the
+// call below finds the stage's validate(const XConfig&) by argument-dependent look-up, whatever
+// else is named validate in namespace traverse.
+struct NoValidate {};
+void validate(NoValidate);
+
+// The stage's validate(config), or nullopt for a config without one.
+template <class Config>
+std::optional<std::string> validate_stage(const Config& config) {
+  if constexpr (requires {
+                  { validate(config) } -> std::convertible_to<std::optional<std::string>>;
+                }) {
+    return validate(config);
+  } else {
+    return std::nullopt;
+  }
+}
 
 }  // namespace config_detail
 

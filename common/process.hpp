@@ -66,9 +66,11 @@ class Process {
   // Adds --replay and --record (see above): for processes of the graph that consume messages.
   void offer_replay();
 
-  // Parses arguments, loads the config file given by --config (if any) into `config`, and
-  // connects to LCM unless `connect` is false. Returns an exit code when the program must stop
-  // now (0 after --help, 2 for a bad command line or config, 1 when LCM cannot start).
+  // Parses arguments, loads the config file given by --config (if any) into `config`, checks it
+  // with the stage's `validate(const Config&)` (found by argument-dependent lookup; see
+  // ConfigCheck), and connects to LCM unless `connect` is false. Returns an exit code when the
+  // program must stop now (0 after --help, 2 for a bad command line or config, naming the key
+  // and the file, 1 when LCM cannot start).
   template <class Config>
   std::optional<int> start(int argc, char** argv, Config& config, bool connect = true) {
     if (auto rc = parse(argc, argv)) return rc;
@@ -76,8 +78,13 @@ class Process {
       if (!config_path_.empty()) {
         WithInput<Config> both{config, input_};
         load_config(config_path_, both);
-        if (auto problem = validate_input(input_))
-          throw ConfigError(config_path_ + ": " + *problem);
+        ConfigCheck check;
+        check.nested("input", validate_input(input_));
+        if (check.problem()) throw ConfigError(config_path_ + ": " + *check.problem());
+      }
+      if (const std::optional<std::string> problem = config_detail::validate_stage(config)) {
+        throw ConfigError((config_path_.empty() ? "default config" : config_path_) + ": " +
+                          *problem);
       }
     } catch (const ConfigError& e) {
       report_config_error(e);

@@ -103,4 +103,10 @@ Eigen::Matrix3d between_jacobian_b(const Pose2& a, const Pose2&) {
   return j;
 }
 
+Eigen::Matrix3d rotate_covariance(const Eigen::Matrix3d& covariance, const Eigen::Matrix2d& R) {
+  Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
+  J.topLeftCorner<2, 2>() = R;
+  return J * covariance * J.transpose();
+}
+
 }  // namespace traverse

@@ -58,4 +58,8 @@ Eigen::Matrix3d compose_jacobian_b(const Pose2& a, const Pose2& b);
 Eigen::Matrix3d between_jacobian_a(const Pose2& a, const Pose2& b);
 Eigen::Matrix3d between_jacobian_b(const Pose2& a, const Pose2& b);
 
+// A covariance of (x, y, theta) in a frame turned by R (the x, y part turns, theta does not):
+// J C J^T with J = diag(R, 1). R = T_a_b.rotation() takes a covariance from frame b into a.
+Eigen::Matrix3d rotate_covariance(const Eigen::Matrix3d& covariance, const Eigen::Matrix2d& R);
+
 }  // namespace traverse

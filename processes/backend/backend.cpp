@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 namespace {
 
@@ -12,38 +14,32 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The matcher's world-frame covariance of a pose, expressed in that pose's own frame (the frame of
-// the pose graph's edge error).
-Eigen::Matrix3d to_pose_frame(const Eigen::Matrix3d& covariance_world, const Pose2& T_world_pose) {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = T_world_pose.rotation().transpose();
-  return R * covariance_world * R.transpose();
-}
-
 }  // namespace
 
-std::string validate(const BackendConfig& c) {
-  if (auto e = validate(c.link); !e.empty()) return "link." + e;
-  if (auto e = validate(c.link_refine); !e.empty()) return "link_refine." + e;
-  if (auto e = validate(c.loop); !e.empty()) return "loop." + e;
-  if (auto e = validate(c.spa); !e.empty()) return "spa." + e;
-  if (c.link_chain_length < 1) return "link_chain_length must be >= 1";
-  if (!(c.fallback_sigma_xy_m > 0.0) || !(c.fallback_sigma_theta_rad > 0.0)) {
-    return "fallback sigmas must be > 0";
-  }
-  if (c.frontend_sigma_xy_m < 0.0 || c.frontend_sigma_theta_rad < 0.0) {
-    return "frontend sigmas must be >= 0 (0: no frontend edge)";
-  }
-  if (c.optimize_every < 1) return "optimize_every must be >= 1";
-  if (c.max_pending_scans < 1) return "max_pending_scans must be >= 1";
-  if (c.smoothing.window < 1) return "smoothing.window must be >= 1";
-  return {};
+std::optional<std::string> validate(const BackendConfig& c) {
+  ConfigCheck check;
+  check.nested("T_base_laser", validate(c.T_base_laser));
+  check.nested("smoothing", validate(c.smoothing));
+  check.nested("key_poses", validate(c.key_poses));
+  check.nested("scans", validate(c.scans));
+  check.nested("link", validate(c.link));
+  check.nested("link_refine", validate(c.link_refine));
+  check.in_range("link_chain_length", c.link_chain_length, 1, 1000);
+  check.in_range("min_link_response", c.min_link_response, 0.0, 1.0);
+  check.positive("fallback_sigma_xy_m", c.fallback_sigma_xy_m);
+  check.positive("fallback_sigma_theta_rad", c.fallback_sigma_theta_rad);
+  check.not_negative("frontend_sigma_xy_m", c.frontend_sigma_xy_m);
+  check.not_negative("frontend_sigma_theta_rad", c.frontend_sigma_theta_rad);
+  check.nested("loop", validate(c.loop));
+  check.nested("spa", validate(c.spa));
+  check.positive("optimize_every", c.optimize_every);
+  check.positive("max_pending_scans", c.max_pending_scans);
+  return check.problem();
 }
 
 Backend::Backend(BackendConfig config)
     : config_(std::move(config)),
-      T_base_laser_(config_.T_base_laser.x_m, config_.T_base_laser.y_m,
-                    config_.T_base_laser.theta_rad),
+      T_base_laser_(config_.T_base_laser.pose()),
       link_matcher_(config_.link),
       link_refiner_(config_.link_refine),
       loop_(config_.loop),
@@ -180,7 +176,8 @@ void Backend::add_key_pose(const PlanarScan& scan) {
           T_world_key = r.T_world_query;
         }
       }
-      covariance = to_pose_frame(m.covariance, T_world_key);
+      // The matcher's covariance is in the world frame; the edge error's in the key pose's.
+      covariance = rotate_covariance(m.covariance, T_world_key.rotation().transpose());
     } else {
       ++counters_.links_fallback;
       const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;

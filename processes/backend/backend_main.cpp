@@ -2,8 +2,6 @@
 // Subscribes to the horizontal scans and the frontend's poses; after each optimisation publishes
 // the key poses that changed with their marginal covariances (KEY_POSES, incremental) and each new
 // key pose once on POSE_BACKEND.
-#include <iostream>
-
 #include "backend_node.hpp"
 #include "process.hpp"
 
@@ -13,11 +11,7 @@ int main(int argc, char** argv) {
                          "closure, SPA, marginal covariances of the key poses");
   traverse::backend::BackendNodeConfig config;
   proc.offer_replay();
-  if (auto rc = proc.start(argc, argv, config)) return *rc;
-  if (const std::string error = traverse::backend::validate(config); !error.empty()) {
-    std::cerr << "traverse-backend: " << proc.config_path() << ": " << error << "\n";
-    return traverse::kConfigErrorExitCode;
-  }
+  if (auto rc = proc.start(argc, argv, config)) return *rc;  // validate(config) included
   traverse::backend::BackendNode node(
       proc.bus(), config, [&proc](const std::string& name, double v) { proc.counter(name) = v; });
   const int rc = proc.spin([&node] { node.report_counters(); });

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "config.hpp"
 #include "scan_message.hpp"
 #include "traverse/key_poses_t.hpp"
 
@@ -17,13 +18,18 @@ void copy_matrix(const Eigen::Matrix3d& m, double out[9]) {
 
 }  // namespace
 
-std::string validate(const BackendNodeConfig& c) {
-  if (c.max_poses_per_message < 1) return "max_poses_per_message must be >= 1";
-  if (c.publish_move_m < 0.0 || c.publish_turn_rad < 0.0 || c.publish_covariance_change < 0.0) {
-    return "publish thresholds must be >= 0";
-  }
-  if (auto e = validate(c.backend); !e.empty()) return "backend." + e;
-  return {};
+std::optional<std::string> validate(const BackendNodeConfig& c) {
+  ConfigCheck check;
+  check.not_empty("scan_channel", c.scan_channel);
+  check.not_empty("pose_channel", c.pose_channel);
+  check.not_empty("key_poses_channel", c.key_poses_channel);
+  check.not_empty("trajectory_channel", c.trajectory_channel);
+  check.in_range("max_poses_per_message", c.max_poses_per_message, 1, 580);
+  check.not_negative("publish_move_m", c.publish_move_m);
+  check.not_negative("publish_turn_rad", c.publish_turn_rad);
+  check.not_negative("publish_covariance_change", c.publish_covariance_change);
+  check.nested("backend", validate(c.backend));
+  return check.problem();
 }
 
 BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink counters)

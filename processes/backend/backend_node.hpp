@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,7 +43,7 @@ struct BackendNodeConfig {
 };
 
 // An error message when a value is out of range, empty when the config is valid.
-std::string validate(const BackendNodeConfig& config);
+std::optional<std::string> validate(const BackendNodeConfig& config);
 
 class BackendNode {
  public:

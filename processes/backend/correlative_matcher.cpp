@@ -2,49 +2,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+
+#include "config.hpp"
+#include "correlative_search.hpp"
 
 namespace traverse::backend {
 namespace {
 
-// The lookup table of section III-B and its block maxima (section IV), on one index space: the
-// coarse value at (ix, iy) is the maximum fine value over [ix, ix + k) x [iy, iy + k).
+// The lookup table of section III-B: cell (ix, iy) covers [origin + ix res, origin + (ix + 1) res)
+// (and likewise in y) and holds exp(-d^2 / 2 sigma^2) of the nearest reference point.
 class LookupTable {
  public:
   LookupTable(const std::vector<Eigen::Vector2d>& points, double resolution, double sigma,
-              int coarse_factor, double margin)
-      : resolution_(resolution), coarse_factor_(coarse_factor) {
+              double margin)
+      : resolution_(resolution) {
     Eigen::Vector2d lo = points.front(), hi = points.front();
     for (const auto& p : points) {
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
     origin_ = lo - Eigen::Vector2d::Constant(margin);
-    width_ = static_cast<int>(std::ceil((hi.x() - lo.x() + 2 * margin) / resolution)) + 1;
-    height_ = static_cast<int>(std::ceil((hi.y() - lo.y() + 2 * margin) / resolution)) + 1;
-    fine_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
+    scores_ = correlative::ScoreTable(
+        static_cast<int>(std::ceil((hi.x() - lo.x() + 2 * margin) / resolution)) + 1,
+        static_cast<int>(std::ceil((hi.y() - lo.y() + 2 * margin) / resolution)) + 1);
     const int radius = static_cast<int>(std::ceil(3.0 * sigma / resolution));
     stamp_all(points, radius, sigma);
-    build_coarse(coarse_factor);
   }
 
-  Eigen::Vector2i index(const Eigen::Vector2d& p) const {
+  std::pair<int, int> index(const Eigen::Vector2d& p) const {
     const Eigen::Vector2d c = (p - origin_) / resolution_;
     return {static_cast<int>(std::floor(c.x())), static_cast<int>(std::floor(c.y()))};
   }
-  float fine(int x, int y) const { return inside(x, y) ? fine_[at(x, y)] : 0.0f; }
-  // A block starting left of or below the table still covers its first cells: clamping the start
-  // keeps the value an upper bound.
-  float coarse(int x, int y) const {
-    if (x < 0 && x > -coarse_factor_) x = 0;
-    if (y < 0 && y > -coarse_factor_) y = 0;
-    return inside(x, y) ? coarse_[at(x, y)] : 0.0f;
-  }
+  const correlative::ScoreTable& scores() const { return scores_; }
 
  private:
-  bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
-  std::size_t at(int x, int y) const { return static_cast<std::size_t>(y) * width_ + x; }
-
   // The kernel is evaluated once per table on cell offsets; a point is snapped to its cell (the
   // cell is a fraction of the kernel width).
   void stamp_all(const std::vector<Eigen::Vector2d>& points, int radius, double sigma) {
@@ -58,68 +51,47 @@ class LookupTable {
       }
     }
     for (const auto& p : points) {
-      const Eigen::Vector2i c = index(p);
+      const auto [cx, cy] = index(p);
       for (int dy = -radius; dy <= radius; ++dy) {
-        const int y = c.y() + dy;
-        if (y < 0 || y >= height_) continue;
         for (int dx = -radius; dx <= radius; ++dx) {
-          const int x = c.x() + dx;
-          if (x < 0 || x >= width_) continue;
-          float& v = fine_[at(x, y)];
+          if (!scores_.inside(cx + dx, cy + dy)) continue;
+          float& v = scores_.at(cx + dx, cy + dy);
           v = std::max(v, kernel[(dy + radius) * side + dx + radius]);
         }
       }
     }
   }
 
-  // Separable sliding maximum over k cells towards +x, then towards +y.
-  void build_coarse(int k) {
-    std::vector<float> rows(fine_.size(), 0.0f);
-    for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        float m = 0.0f;
-        for (int d = 0; d < k && x + d < width_; ++d) m = std::max(m, fine_[at(x + d, y)]);
-        rows[at(x, y)] = m;
-      }
-    }
-    coarse_.assign(fine_.size(), 0.0f);
-    for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        float m = 0.0f;
-        for (int d = 0; d < k && y + d < height_; ++d) m = std::max(m, rows[at(x, y + d)]);
-        coarse_[at(x, y)] = m;
-      }
-    }
-  }
-
   double resolution_;
-  int coarse_factor_;
   Eigen::Vector2d origin_;
-  int width_ = 0, height_ = 0;
-  std::vector<float> fine_, coarse_;
-};
-
-struct Candidate {
-  double bound;  // upper bound of the (penalised or raw) response in the block
-  int angle;     // heading step index in [0, 2A]
-  int i0, j0;    // first translation step of the block, in [-W, W]
+  correlative::ScoreTable scores_;
 };
 
 }  // namespace
 
-std::string validate(const CorrelativeMatcherConfig& c) {
-  if (!(c.resolution_m > 0.0)) return "resolution_m must be > 0";
-  if (c.coarse_factor < 1) return "coarse_factor must be >= 1";
-  if (!(c.angle_step_rad > 0.0)) return "angle_step_rad must be > 0";
-  if (c.linear_window_m < 0.0 || c.angular_window_rad < 0.0) return "windows must be >= 0";
-  if (!(c.kernel_sigma_m > 0.0)) return "kernel_sigma_m must be > 0";
-  if (!(c.penalty_sigma_xy_m > 0.0) || !(c.penalty_sigma_theta_rad > 0.0)) {
-    return "penalty sigmas must be > 0";
-  }
-  if (c.covariance_response_drop < 0.0) return "covariance_response_drop must be >= 0";
-  if (c.covariance_window_cells < 1) return "covariance_window_cells must be >= 1";
-  if (c.max_query_points < 1) return "max_query_points must be >= 1";
-  return {};
+std::optional<std::string> validate(const CorrelativeMatcherConfig& c) {
+  ConfigCheck check;
+  check.in_range("resolution_m", c.resolution_m, 0.001, 1.0);
+  check.in_range("coarse_factor", c.coarse_factor, 1, 64);
+  check.positive("angle_step_rad", c.angle_step_rad);
+  check.not_negative("linear_window_m", c.linear_window_m);
+  check.in_range("angular_window_rad", c.angular_window_rad, 0.0, M_PI);
+  check.positive("kernel_sigma_m", c.kernel_sigma_m);
+  check.positive("penalty_sigma_xy_m", c.penalty_sigma_xy_m);
+  check.positive("penalty_sigma_theta_rad", c.penalty_sigma_theta_rad);
+  check.not_negative("covariance_response_drop", c.covariance_response_drop);
+  check.in_range("covariance_window_cells", c.covariance_window_cells, 1, 100);
+  check.in_range("max_query_points", c.max_query_points, 1, 100000);
+  if (check.problem()) return check.problem();
+  // The search volume: translations (2 W + 1)^2 per heading, 2 A + 1 headings, and the table's
+  // kernel; more than these take seconds per match.
+  check.require(c.linear_window_m / c.resolution_m <= 1000.0, "linear_window_m",
+                "must be at most 1000 cells of resolution_m");
+  check.require(c.angular_window_rad / c.angle_step_rad <= 1000.0, "angular_window_rad",
+                "must be at most 1000 angle steps");
+  check.require(c.kernel_sigma_m / c.resolution_m <= 100.0, "kernel_sigma_m",
+                "must be at most 100 cells of resolution_m");
+  return check.problem();
 }
 
 CorrelativeMatcher::CorrelativeMatcher(CorrelativeMatcherConfig config)
@@ -133,78 +105,48 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
   if (reference_world.empty() || query_all.empty()) return result;
   const CorrelativeMatcherConfig& c = config_;
   const double res = c.resolution_m, step = c.angle_step_rad;
-  const int k = c.coarse_factor;
   const int W = static_cast<int>(std::ceil(c.linear_window_m / res));
   const int A = static_cast<int>(std::ceil(c.angular_window_rad / step));
-  const LookupTable table(reference_world, res, c.kernel_sigma_m, k, 3.0 * c.kernel_sigma_m);
+  const LookupTable table(reference_world, res, c.kernel_sigma_m, 3.0 * c.kernel_sigma_m);
+  const correlative::BlockBound coarse(table.scores(), c.coarse_factor);
 
   // Query points thinned evenly.
   const std::size_t stride = (query_all.size() + c.max_query_points - 1) / c.max_query_points;
   std::vector<Eigen::Vector2d> query;
   for (std::size_t i = 0; i < query_all.size(); i += stride) query.push_back(query_all[i]);
   const double n = static_cast<double>(query.size());
+  const correlative::RotatedScans scans(query, T_world_guess, A, step,
+                                        [&](const Eigen::Vector2d& p) { return table.index(p); });
 
-  // Table index of every query point at each heading, translated by the guess (section IV: the
-  // rotation is applied once per heading, translations are index offsets).
-  std::vector<std::vector<Eigen::Vector2i>> indices(2 * A + 1);
-  for (int a = 0; a <= 2 * A; ++a) {
-    const Pose2 T(T_world_guess.x(), T_world_guess.y(), T_world_guess.theta() + (a - A) * step);
-    indices[a].reserve(query.size());
-    for (const auto& p : query) indices[a].push_back(table.index(T * p));
-  }
+  // The penalty for straying from the guess, at its least over the translations [i, i + size) x
+  // [j, j + size) (the one nearest the guess) of heading a; the response is the mean table value.
   const auto penalty = [&](double di2_cells, int a) {
     const double dth = (a - A) * step;
     return std::exp(-0.5 * (di2_cells * res * res / (c.penalty_sigma_xy_m * c.penalty_sigma_xy_m) +
                             dth * dth / (c.penalty_sigma_theta_rad * c.penalty_sigma_theta_rad)));
   };
-  const auto fine_sum = [&](int a, int i, int j) {
-    double s = 0.0;
-    for (const auto& q : indices[a]) s += table.fine(q.x() + i, q.y() + j);
-    return s / n;
-  };
-  // Smallest |v| over v in [lo, hi].
   const auto closest = [](int lo, int hi) { return lo > 0 ? lo : (hi < 0 ? -hi : 0); };
+  const auto penalised = [&](double sum, int a, int i, int j, int size) {
+    const int ci = closest(i, std::min(i + size - 1, W));
+    const int cj = closest(j, std::min(j + size - 1, W));
+    return sum / n * penalty(ci * ci + cj * cj, a);
+  };
+  const auto no_visit = [](const correlative::ScoredPose<double>&, double) {};
 
-  // Coarse pass: one bound per block and heading.
-  std::vector<Candidate> penalised, raw;
-  for (int a = 0; a <= 2 * A; ++a) {
-    for (int i0 = -W; i0 <= W; i0 += k) {
-      for (int j0 = -W; j0 <= W; j0 += k) {
-        double s = 0.0;
-        for (const auto& q : indices[a]) s += table.coarse(q.x() + i0, q.y() + j0);
-        s /= n;
-        const int ci = closest(i0, std::min(i0 + k - 1, W));
-        const int cj = closest(j0, std::min(j0 + k - 1, W));
-        penalised.push_back({s * penalty(ci * ci + cj * cj, a), a, i0, j0});
-        raw.push_back({s, a, i0, j0});
-      }
-    }
-  }
-  result.evaluations = static_cast<long>(penalised.size());
-  const auto by_bound = [](const Candidate& x, const Candidate& y) { return x.bound > y.bound; };
-
-  // Fine pass, best-first, until no block can beat the best.
-  std::sort(penalised.begin(), penalised.end(), by_bound);
-  double best = -1.0;
-  int best_a = A, best_i = 0, best_j = 0;
-  for (const Candidate& cand : penalised) {
-    if (cand.bound <= best) break;
-    for (int i = cand.i0; i < cand.i0 + k && i <= W; ++i) {
-      for (int j = cand.j0; j < cand.j0 + k && j <= W; ++j) {
-        ++result.evaluations;
-        const double s = fine_sum(cand.angle, i, j) * penalty(i * i + j * j, cand.angle);
-        if (s > best) best = s, best_a = cand.angle, best_i = i, best_j = j;
-      }
-    }
-  }
+  // Multi-resolution search (section IV), best-first until no block can beat the best.
+  const auto search = correlative::branch_and_bound<double>(
+      scans, table.scores(), coarse, W, {-1.0, A, 0, 0}, 0.0, penalised, no_visit);
+  result.evaluations = static_cast<long>(search.blocks + search.scored);
+  const double best = search.best.score;
+  const int best_a = search.best.a, best_i = search.best.dx, best_j = search.best.dy;
   result.valid = true;
   result.response = best;
-  result.raw_response = fine_sum(best_a, best_i, best_j);
+  result.raw_response = scans.sum<double>(table.scores(), best_a, best_i, best_j) / n;
   // Sub-step refinement: the vertex of a parabola through the best pose and its two neighbours,
   // per axis (the table is smooth at the kernel scale, so the peak is locally quadratic).
   const auto score = [&](int a, int i, int j) {
     if (a < 0 || a > 2 * A || std::abs(i) > W || std::abs(j) > W) return -1.0;
-    return fine_sum(a, i, j) * penalty(i * i + j * j, a);
+    return penalised(scans.sum<double>(table.scores(), a, i, j), a, i, j, 1);
   };
   const auto vertex = [&](double minus, double plus) {
     const double curvature = minus - 2.0 * best + plus;
@@ -219,48 +161,37 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
   result.T_world_query = Pose2(T_world_guess.x() + (best_i + di) * res,
                                T_world_guess.y() + (best_j + dj) * res, theta);
 
-  // Second peak: the same search on raw responses, skipping poses near the best translation.
+  // Second peak: the same search on raw responses, poses near the best translation left out.
   if (second_peak_exclusion_m > 0.0) {
     const double excl2 = std::pow(second_peak_exclusion_m / res, 2);
-    const auto far = [&](int i, int j) {
-      return (i - best_i) * (i - best_i) + (j - best_j) * (j - best_j) >= excl2;
-    };
-    std::sort(raw.begin(), raw.end(), by_bound);
-    double second = 0.0;
-    for (const Candidate& cand : raw) {
-      if (cand.bound <= second) break;
-      for (int i = cand.i0; i < cand.i0 + k && i <= W; ++i) {
-        for (int j = cand.j0; j < cand.j0 + k && j <= W; ++j) {
-          if (!far(i, j)) continue;
-          ++result.evaluations;
-          second = std::max(second, fine_sum(cand.angle, i, j));
-        }
+    const auto far_raw = [&](double sum, int a, int i, int j, int size) {
+      (void)a;
+      if (size == 1 && (i - best_i) * (i - best_i) + (j - best_j) * (j - best_j) < excl2) {
+        return -std::numeric_limits<double>::infinity();
       }
-    }
-    result.second_peak_response = second;
+      return sum / n;
+    };
+    const auto second = correlative::branch_and_bound<double>(
+        scans, table.scores(), coarse, W, {0.0, A, 0, 0}, 0.0, far_raw, no_visit);
+    result.evaluations += static_cast<long>(second.scored);
+    result.second_peak_response = second.best.score;
   }
 
   // Covariance from the spread of the response around the best pose (section III-D).
   const int cw = c.covariance_window_cells;
-  double wsum = 0.0;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d second_moment = Eigen::Matrix3d::Zero();
+  correlative::ScoreSpread spread;
   for (int a = std::max(0, best_a - cw); a <= std::min(2 * A, best_a + cw); ++a) {
     for (int i = std::max(-W, best_i - cw); i <= std::min(W, best_i + cw); ++i) {
       for (int j = std::max(-W, best_j - cw); j <= std::min(W, best_j + cw); ++j) {
         ++result.evaluations;
-        const double s = fine_sum(a, i, j) * penalty(i * i + j * j, a);
+        const double s = penalised(scans.sum<double>(table.scores(), a, i, j), a, i, j, 1);
         if (s < best - c.covariance_response_drop) continue;
-        const Eigen::Vector3d x((i - best_i) * res, (j - best_j) * res, (a - best_a) * step);
-        wsum += s;
-        mean += s * x;
-        second_moment += s * x * x.transpose();
+        spread.add(s, Eigen::Vector3d((i - best_i) * res, (j - best_j) * res, (a - best_a) * step));
       }
     }
   }
-  if (wsum > 0.0) {
-    mean /= wsum;
-    result.covariance = second_moment / wsum - mean * mean.transpose();
+  if (spread.weight() > 0.0) {
+    result.covariance = spread.about_mean();
   } else {  // nothing overlaps anywhere: the whole window is equally likely
     result.covariance =
         Eigen::Vector3d(W * W * res * res, W * W * res * res, A * A * step * step).asDiagonal();

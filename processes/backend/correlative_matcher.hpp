@@ -20,6 +20,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "se2.hpp"
@@ -56,8 +58,8 @@ struct CorrelativeMatcherConfig {
   }
 };
 
-// An error message when a value is out of range, empty when the config is valid.
-std::string validate(const CorrelativeMatcherConfig& config);
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const CorrelativeMatcherConfig& config);
 
 struct MatchResult {
   bool valid = false;         // false: no reference or query points

@@ -4,23 +4,29 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 
-std::string validate(const LoopCloserConfig& c) {
-  if (!(c.search_radius_m > 0.0) || !(c.chain_radius_m >= c.search_radius_m)) {
-    return "search_radius_m must be > 0 and chain_radius_m >= search_radius_m";
-  }
-  if (c.min_travel_m < 0.0) return "min_travel_m must be >= 0";
-  if (c.max_chain_length < 1 || c.max_candidates < 1) {
-    return "max_chain_length and max_candidates must be >= 1";
-  }
-  if (c.max_ambiguity_ratio <= 0.0 || c.ambiguity_exclusion_m <= 0.0) {
-    return "max_ambiguity_ratio and ambiguity_exclusion_m must be > 0";
-  }
-  if (auto e = validate(c.coarse); !e.empty()) return "coarse." + e;
-  if (auto e = validate(c.fine); !e.empty()) return "fine." + e;
-  if (auto e = validate(c.refine); !e.empty()) return "refine." + e;
-  return {};
+std::optional<std::string> validate(const LoopCloserConfig& c) {
+  ConfigCheck check;
+  check.positive("search_radius_m", c.search_radius_m);
+  check.require(c.chain_radius_m >= c.search_radius_m, "chain_radius_m",
+                "must be at least search_radius_m");
+  check.not_negative("min_travel_m", c.min_travel_m);
+  check.in_range("max_chain_length", c.max_chain_length, 1, 10000);
+  check.in_range("max_candidates", c.max_candidates, 1, 10000);
+  check.in_range("min_coarse_response", c.min_coarse_response, 0.0, 1.0);
+  check.in_range("min_fine_response", c.min_fine_response, 0.0, 1.0);
+  check.positive("max_ambiguity_ratio", c.max_ambiguity_ratio);
+  check.positive("ambiguity_exclusion_m", c.ambiguity_exclusion_m);
+  check.positive("max_sigma_xy_m", c.max_sigma_xy_m);
+  check.positive("max_sigma_theta_rad", c.max_sigma_theta_rad);
+  check.not_negative("max_correction_mahalanobis", c.max_correction_mahalanobis);
+  check.nested("coarse", validate(c.coarse));
+  check.nested("fine", validate(c.fine));
+  check.nested("refine", validate(c.refine));
+  return check.problem();
 }
 
 LoopCloser::LoopCloser(LoopCloserConfig config)
@@ -96,9 +102,7 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   }
   // The matcher's covariance is in the world frame; the edge error's translation is in the frame
   // of the `to` pose.
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = T_world_current.rotation().transpose();
-  closure.covariance = R * covariance * R.transpose();
+  closure.covariance = rotate_covariance(covariance, T_world_current.rotation().transpose());
   closure.response = fine.raw_response;
   closure.second_peak = ambiguity;
   return closure;

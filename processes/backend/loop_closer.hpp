@@ -38,20 +38,39 @@ struct LoopCloserConfig {
   double min_coarse_response = 0.5;   // [0..1]
   double min_fine_response = 0.6;     // [0..1]
   double max_ambiguity_ratio = 0.85;  // second peak / peak above this: ambiguous, rejected
-  double ambiguity_exclusion_m = 0.3;  // the second peak lies at least this far from the peak [m]
-  double max_sigma_xy_m = 0.08;        // largest standard deviation of the fine match [m]
-  double max_sigma_theta_rad = 0.02;   // [rad]
+  // The second peak lies at least this far from the peak [m]: repeated shelves or doors 0.5 m
+  // apart must count as a second peak.
+  double ambiguity_exclusion_m = 0.3;
+  double max_sigma_xy_m = 0.08;       // largest standard deviation of the fine match [m]
+  double max_sigma_theta_rad = 0.02;  // [rad]
   // 5. The correction the closure implies for the current pose, against the sum of the match's
   //    covariance and the marginals of both key poses: above this Mahalanobis distance the
   //    closure contradicts the graph (0: not checked).
   double max_correction_mahalanobis = 5.0;
-  // Matcher settings in field order: resolution_m, coarse_factor, angle_step_rad,
-  // linear_window_m, angular_window_rad, kernel_sigma_m, penalty_sigma_xy_m,
-  // penalty_sigma_theta_rad, covariance_response_drop, covariance_window_cells, max_query_points.
   // Coarse: a wide window (the drift a loop can carry) on a 5 cm grid, almost no penalty.
-  CorrelativeMatcherConfig coarse{0.05, 8, 0.01, 2.0, 0.35, 0.06, 10.0, 2.0, 0.05, 10, 300};
+  CorrelativeMatcherConfig coarse{.resolution_m = 0.05,
+                                  .coarse_factor = 8,
+                                  .angle_step_rad = 0.01,
+                                  .linear_window_m = 2.0,
+                                  .angular_window_rad = 0.35,
+                                  .kernel_sigma_m = 0.06,
+                                  .penalty_sigma_xy_m = 10.0,
+                                  .penalty_sigma_theta_rad = 2.0,
+                                  .covariance_response_drop = 0.05,
+                                  .covariance_window_cells = 10,
+                                  .max_query_points = 300};
   // Fine: around the coarse peak on a 2 cm grid.
-  CorrelativeMatcherConfig fine{0.02, 4, 0.002, 0.12, 0.03, 0.03, 10.0, 2.0, 0.05, 8, 400};
+  CorrelativeMatcherConfig fine{.resolution_m = 0.02,
+                                .coarse_factor = 4,
+                                .angle_step_rad = 0.002,
+                                .linear_window_m = 0.12,
+                                .angular_window_rad = 0.03,
+                                .kernel_sigma_m = 0.03,
+                                .penalty_sigma_xy_m = 10.0,
+                                .penalty_sigma_theta_rad = 2.0,
+                                .covariance_response_drop = 0.05,
+                                .covariance_window_cells = 8,
+                                .max_query_points = 400};
   // Then point-to-line refinement of the fine match (scan_refiner.hpp): the closure takes its pose
   // and keeps the fine match's covariance. The refinement's own covariance was measured too
   // tight on the simulated office (closure heading errors of 1e-4 rad against 2e-5 rad), and
@@ -80,7 +99,7 @@ struct LoopCloserConfig {
   }
 };
 
-std::string validate(const LoopCloserConfig& config);
+std::optional<std::string> validate(const LoopCloserConfig& config);
 
 struct LoopClosure {
   int from = 0;     // old key pose of the chain (nearest to the match)
@@ -100,8 +119,8 @@ struct LoopCloserCounters {
   long rejected_response = 0;  // coarse or fine response too low
   long rejected_ambiguous = 0;
   long rejected_covariance = 0;
-  long refined = 0;        // fine matches refined point to line
-  long refine_failed = 0;  // ... where refinement failed (the fine match is kept)
+  long refined = 0;                // fine matches refined point to line
+  long refine_failed = 0;          // ... where refinement failed (the fine match is kept)
   long rejected_inconsistent = 0;  // correction too large for the marginals
   long closures = 0;
 };

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <unordered_map>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 namespace {
 
@@ -15,8 +17,10 @@ namespace {
 // distance are in the 3 x 3 cells around a point.
 class PointHash {
  public:
-  PointHash(const std::vector<Eigen::Vector2d>& points, double cell) : points_(points), cell_(cell) {
-    for (int i = 0; i < static_cast<int>(points.size()); ++i) cells_[key(cell_of(points[i]))].push_back(i);
+  PointHash(const std::vector<Eigen::Vector2d>& points, double cell)
+      : points_(points), cell_(cell) {
+    for (int i = 0; i < static_cast<int>(points.size()); ++i)
+      cells_[key(cell_of(points[i]))].push_back(i);
   }
 
   template <class F>
@@ -93,25 +97,24 @@ Eigen::Matrix3d inverse_constrained(const Eigen::Matrix3d& H, double lever_m) {
 
 }  // namespace
 
-std::string validate(const RefinerConfig& c) {
-  if (!(c.normal_radius_m > 0.0)) return "normal_radius_m must be > 0";
-  if (!(c.max_line_thickness > 0.0 && c.max_line_thickness < 1.0)) {
-    return "max_line_thickness must be in (0, 1)";
-  }
-  if (!(c.min_line_gate_m > 0.0) || c.max_correspondence_m < c.min_line_gate_m ||
-      c.max_correspondence_m > c.normal_radius_m) {
-    return "need 0 < min_line_gate_m <= max_correspondence_m <= normal_radius_m";
-  }
-  if (!(c.huber_m > 0.0)) return "huber_m must be > 0";
-  if (c.iterations < 1) return "iterations must be >= 1";
-  if (!(c.min_inlier_fraction > 0.0 && c.min_inlier_fraction <= 1.0)) {
-    return "min_inlier_fraction must be in (0, 1]";
-  }
-  if (!(c.max_shift_m > 0.0) || !(c.max_turn_rad > 0.0)) {
-    return "max_shift_m and max_turn_rad must be > 0";
-  }
-  if (!(c.covariance_scale >= 1.0)) return "covariance_scale must be >= 1";
-  return {};
+std::optional<std::string> validate(const RefinerConfig& c) {
+  ConfigCheck check;
+  check.positive("normal_radius_m", c.normal_radius_m);
+  check.require(c.max_line_thickness > 0.0 && c.max_line_thickness < 1.0, "max_line_thickness",
+                "must be in (0, 1)");
+  check.positive("min_line_gate_m", c.min_line_gate_m);
+  check.require(c.max_correspondence_m >= c.min_line_gate_m, "max_correspondence_m",
+                "must be at least min_line_gate_m");
+  check.require(c.max_correspondence_m <= c.normal_radius_m, "max_correspondence_m",
+                "must be at most normal_radius_m");
+  check.positive("huber_m", c.huber_m);
+  check.in_range("iterations", c.iterations, 1, 1000);
+  check.require(c.min_inlier_fraction > 0.0 && c.min_inlier_fraction <= 1.0, "min_inlier_fraction",
+                "must be in (0, 1]");
+  check.positive("max_shift_m", c.max_shift_m);
+  check.positive("max_turn_rad", c.max_turn_rad);
+  check.require(c.covariance_scale >= 1.0, "covariance_scale", "must be at least 1");
+  return check.problem();
 }
 
 RefineResult ScanRefiner::refine(const std::vector<Eigen::Vector2d>& reference,

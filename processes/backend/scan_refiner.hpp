@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,9 +30,9 @@ struct RefinerConfig {
   double normal_radius_m = 0.15;       // reference neighbours within this fit the line [m]
   double max_line_thickness = 0.1;     // smallest / largest spread of those neighbours (0..1)
   double max_correspondence_m = 0.08;  // nearest reference point within this is the partner [m]
-  double min_line_gate_m = 0.01;  // point-to-line distances beyond 3 RMS residuals of the last
+  double min_line_gate_m = 0.01;       // point-to-line distances beyond 3 RMS residuals of the last
                                   // iteration are not used, but this many metres always are [m]
-  double huber_m = 0.005;              // residuals beyond this are down-weighted [m]
+  double huber_m = 0.005;  // residuals beyond this are down-weighted [m]
   int iterations = 15;
   double min_inlier_fraction = 0.3;  // fewer query points with a correspondence: not refined
   double max_shift_m = 0.05;         // a refinement farther than this from the start is refused
@@ -55,11 +56,11 @@ struct RefinerConfig {
 };
 
 // An error message when a value is out of range, empty when the config is valid.
-std::string validate(const RefinerConfig& config);
+std::optional<std::string> validate(const RefinerConfig& config);
 
 struct RefineResult {
-  bool valid = false;            // false: too few correspondences, or it moved too far
-  Pose2 T_world_query;           // refined pose (the start pose when not valid)
+  bool valid = false;   // false: too few correspondences, or it moved too far
+  Pose2 T_world_query;  // refined pose (the start pose when not valid)
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // world frame: m^2, m rad, rad^2
   double rms_residual_m = 0.0;   // [m] weighted RMS point-to-line distance at the end
   double inlier_fraction = 0.0;  // query points with a correspondence at the end [0..1]
@@ -72,8 +73,7 @@ class ScanRefiner {
   explicit ScanRefiner(RefinerConfig config) : config_(std::move(config)) {}
 
   RefineResult refine(const std::vector<Eigen::Vector2d>& reference_world,
-                      const std::vector<Eigen::Vector2d>& query,
-                      const Pose2& T_world_start) const;
+                      const std::vector<Eigen::Vector2d>& query, const Pose2& T_world_start) const;
 
   const RefinerConfig& config() const { return config_; }
 

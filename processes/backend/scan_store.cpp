@@ -3,7 +3,17 @@
 #include <algorithm>
 #include <cmath>
 
+#include "config.hpp"
+
 namespace traverse::backend {
+
+std::optional<std::string> validate(const ScanStoreConfig& c) {
+  ConfigCheck check;
+  check.not_negative("point_spacing_m", c.point_spacing_m);
+  check.not_negative("min_range_m", c.min_range_m);
+  check.require(c.max_range_m > c.min_range_m, "max_range_m", "must exceed min_range_m");
+  return check.problem();
+}
 
 std::vector<Eigen::Vector2f> reduce_scan(const PlanarScan& scan, const Pose2& T_base_laser,
                                          const std::function<Pose2(int64_t)>& T_ref_base,

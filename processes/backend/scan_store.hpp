@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "planar_scan.hpp"
@@ -34,6 +36,8 @@ struct ScanStoreConfig {
     v("max_range_m", max_range_m);
   }
 };
+
+std::optional<std::string> validate(const ScanStoreConfig& config);
 
 // Points of `scan` in the base frame at time utime_ref: beam i is placed with
 // T_ref_base(t_i) * T_base_laser, where T_ref_base(t) is the motion of the base relative to its

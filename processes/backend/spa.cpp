@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "config.hpp"
 #include "marginals.hpp"
 
 namespace traverse::backend {
@@ -24,22 +25,22 @@ int factorization_of(const std::string& name) {
 
 }  // namespace
 
-std::string validate(const SpaConfig& c) {
-  if (c.ordering != "block_amd" && c.ordering != "block_metis" && c.ordering != "cholmod_default") {
-    return "ordering must be block_amd, block_metis or cholmod_default, not '" + c.ordering + "'";
-  }
-  if (c.factorization != "simplicial" && c.factorization != "supernodal" &&
-      c.factorization != "auto") {
-    return "factorization must be simplicial, supernodal or auto, not '" + c.factorization + "'";
-  }
-  if (c.max_iterations < 1) return "max_iterations must be at least 1";
-  if (!(c.initial_lambda > 0.0) || !(c.max_lambda > c.initial_lambda)) {
-    return "need 0 < initial_lambda < max_lambda";
-  }
-  if (c.relative_chi2_tolerance < 0.0 || c.step_tolerance < 0.0 || c.gradient_tolerance < 0.0) {
-    return "tolerances must not be negative";
-  }
-  return "";
+std::optional<std::string> validate(const SpaConfig& c) {
+  ConfigCheck check;
+  check.require(
+      c.ordering == "block_amd" || c.ordering == "block_metis" || c.ordering == "cholmod_default",
+      "ordering", "must be block_amd, block_metis or cholmod_default, not '" + c.ordering + "'");
+  check.require(c.factorization == "simplicial" || c.factorization == "supernodal" ||
+                    c.factorization == "auto",
+                "factorization",
+                "must be simplicial, supernodal or auto, not '" + c.factorization + "'");
+  check.positive("max_iterations", c.max_iterations);
+  check.positive("initial_lambda", c.initial_lambda);
+  check.require(c.max_lambda > c.initial_lambda, "max_lambda", "must exceed initial_lambda");
+  check.not_negative("relative_chi2_tolerance", c.relative_chi2_tolerance);
+  check.not_negative("step_tolerance", c.step_tolerance);
+  check.not_negative("gradient_tolerance", c.gradient_tolerance);
+  return check.problem();
 }
 
 SpaOptimizer::SpaOptimizer(SpaConfig config)

@@ -47,7 +47,7 @@ struct SpaConfig {
 };
 
 // An error message when a value of the config is out of range, empty when it is valid.
-std::string validate(const SpaConfig& config);
+std::optional<std::string> validate(const SpaConfig& config);
 
 struct SpaResult {
   double initial_chi2 = 0.0;

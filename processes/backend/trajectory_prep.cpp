@@ -4,6 +4,8 @@
 #include <cmath>
 #include <deque>
 
+#include "config.hpp"
+
 namespace traverse::backend {
 namespace {
 
@@ -36,6 +38,27 @@ bool is_jump(const Eigen::Vector3d& v, double dt, const Eigen::Vector3d& mean,
 }
 
 }  // namespace
+
+std::optional<std::string> validate(const JumpSmoothingConfig& c) {
+  ConfigCheck check;
+  check.in_range("window", c.window, 1, 1000);
+  check.positive("speed_ratio", c.speed_ratio);
+  check.not_negative("min_jump_speed_mps", c.min_jump_speed_mps);
+  check.positive("max_direction_change_rad", c.max_direction_change_rad);
+  check.not_negative("min_moving_speed_mps", c.min_moving_speed_mps);
+  check.positive("max_turn_rate_radps", c.max_turn_rate_radps);
+  check.not_negative("min_jump_m", c.min_jump_m);
+  check.not_negative("min_jump_rad", c.min_jump_rad);
+  return check.problem();
+}
+
+std::optional<std::string> validate(const KeyPoseConfig& c) {
+  ConfigCheck check;
+  check.positive("interval_us", c.interval_us);
+  check.not_negative("distance_m", c.distance_m);
+  check.not_negative("angle_rad", c.angle_rad);
+  return check.problem();
+}
 
 SmoothedTrajectory smooth_jumps(std::vector<StampedPose> poses, const JumpSmoothingConfig& config) {
   SmoothedTrajectory out;

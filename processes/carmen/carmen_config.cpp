@@ -18,8 +18,8 @@ std::optional<std::string> validate(const CarmenConfig& c) {
   check.require(c.no_return_min_fraction > 0.0 && c.no_return_min_fraction <= 1.0,
                 "no_return_min_fraction", "must be in (0, 1]");
   check.in_range("max_beams", c.max_beams, 1, kMaxBeams);
-  check.positive("max_timestamp_quantum_s", c.max_timestamp_quantum_s);
-  check.positive("nominal_scan_period_s", c.nominal_scan_period_s);
+  check.in_range("max_timestamp_quantum_s", c.max_timestamp_quantum_s, 1e-6, 1e9);
+  check.in_range("nominal_scan_period_s", c.nominal_scan_period_s, 1e-6, 3600.0);
   check.require(c.odometry_source == "auto" || c.odometry_source == "odom" ||
                     c.odometry_source == "laser" || c.odometry_source == "none",
                 "odometry_source",

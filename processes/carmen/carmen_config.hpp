@@ -1,4 +1,5 @@
-// Settings of the CARMEN log driver (configs/carmen.yaml says what each is for).
+// Settings of the CARMEN log driver: every key with its default and meaning (configs/carmen.yaml
+// holds what a deployment sets).
 #pragma once
 
 #include <optional>

@@ -67,12 +67,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   carmen::CarmenConfig cfg;
   const bool to_file = writes_log_file(argc, argv);
-  if (auto rc = proc.start(argc, argv, cfg, !to_file)) return *rc;
-  if (const auto problem = carmen::validate(cfg)) {
-    spdlog::error("traverse-carmen: config error: {}: {}",
-                  proc.config_path().empty() ? "(defaults)" : proc.config_path(), *problem);
-    return traverse::kConfigErrorExitCode;
-  }
+  if (auto rc = proc.start(argc, argv, cfg, !to_file)) return *rc;  // validate(cfg) included
   if (log_path.empty()) {
     spdlog::error("traverse-carmen: no CARMEN log given (see --help)");
     return traverse::kConfigErrorExitCode;

@@ -5,7 +5,25 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "config.hpp"
+
 namespace traverse::densifier {
+
+std::optional<std::string> validate(const DensifierConfig& c) {
+  ConfigCheck check;
+  check.require(parse_mode(c.mode).has_value(), "mode",
+                "must be paper or rigid, not '" + c.mode + "'");
+  check.not_negative("turn_lever_m", c.turn_lever_m);
+  check.not_negative("republish_threshold_m", c.republish_threshold_m);
+  check.not_negative("republish_threshold_rad", c.republish_threshold_rad);
+  check.not_empty("parent_frame", c.parent_frame);
+  check.not_empty("key_pose_channel", c.key_pose_channel);
+  // Below a few kilobytes a message holds only a handful of segments and bursts grow long again;
+  // above 64 KB it no longer fits one UDP datagram.
+  check.in_range("max_message_bytes", c.max_message_bytes, 4096, 65000);
+  check.not_negative("spike_threshold_m", c.spike_threshold_m);
+  return check.problem();
+}
 
 std::optional<Mode> parse_mode(const std::string& name) {
   if (name == "paper") return Mode::kPaper;
@@ -200,8 +218,8 @@ std::vector<Segment> Densifier::settle() {
   return out;
 }
 
-void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it,
-                                std::vector<Segment>& out, bool exact) {
+void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out,
+                                bool exact) {
   if (it == keys_.end()) return;
   auto next = std::next(it);
   if (next == keys_.end() || !it->second.placed || !next->second.placed) return;

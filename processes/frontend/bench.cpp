@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <ctime>
 #include <deque>
+#include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <vector>
@@ -57,7 +59,7 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
     const fe::FrontendResult r = frontend.process(scan);
     timing.ms.push_back(cpu_ms() - t0);
     timing.points = static_cast<int>(scan.ranges.size());
-    timing.matched_points = r.matched_points;
+    if (r.diagnostics) timing.matched_points = r.diagnostics->matched_points;
     if (r.has_pose()) estimates.emplace_back(r.utime, r.T_map_base);
   };
   while (auto ev = reader.next()) {
@@ -138,7 +140,7 @@ Timing run_synthetic(int scans, fe::Frontend& frontend) {
     const fe::FrontendResult r = frontend.process(scan);
     timing.ms.push_back(cpu_ms() - t0);
     timing.points = spec.n_ranges;
-    timing.matched_points = r.matched_points;
+    if (r.diagnostics) timing.matched_points = r.diagnostics->matched_points;
     // The map frame is the base at the first scan's last point.
     const traverse::Pose2 T_map_base_true =
         truth(spec.duration_us).inverse() * truth(scan.utime_last);
@@ -163,15 +165,15 @@ int main(int argc, char** argv) {
   fe::FrontendConfig config;
   try {
     if (!config_path.empty()) traverse::load_config(config_path, config);
-    if (auto problem = fe::config_problem(config)) throw traverse::ConfigError(*problem);
+    if (auto problem = fe::validate(config)) throw traverse::ConfigError(*problem);
   } catch (const traverse::ConfigError& e) {
     std::fprintf(stderr, "traverse-frontend-bench: %s\n", e.what());
     return traverse::kConfigErrorExitCode;
   }
-  fe::Frontend frontend(config);
+  const std::unique_ptr<fe::Frontend> frontend = fe::make_frontend(config);
   Timing t;
   try {
-    t = log_path.empty() ? run_synthetic(scans, frontend) : run_log(log_path, frontend);
+    t = log_path.empty() ? run_synthetic(scans, *frontend) : run_log(log_path, *frontend);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "traverse-frontend-bench: %s\n", e.what());
     return 1;
@@ -188,7 +190,8 @@ int main(int argc, char** argv) {
   const double mean =
       std::accumulate(t.ms.begin(), t.ms.end(), 0.0) / static_cast<double>(t.ms.size());
   const double rtf = (1000.0 / t.rate_hz) / mean;
-  const auto& c = frontend.counters();
+  std::map<std::string, double> c;
+  frontend->report([&c](const std::string& name, double value) { c[name] = value; });
   std::printf("input: %s\n", log_path.empty() ? "synthetic office corridor" : log_path.c_str());
   std::printf("sweeps: %zu of %d points at %.1f Hz; %d points matched per scan after subsampling\n",
               t.ms.size(), t.points, t.rate_hz, t.matched_points);
@@ -196,9 +199,8 @@ int main(int argc, char** argv) {
               p99, mean, sorted.back());
   std::printf("real-time factor at %.1f Hz on one core: %.1fx (scan period / mean time)\n",
               t.rate_hz, rtf);
-  std::printf("map: %zu bytes after %lld updates; %lld scans needed the recovery search\n",
-              frontend.map_memory_bytes(), static_cast<long long>(c.map_updates),
-              static_cast<long long>(c.scans_searched));
+  std::printf("map: %zu bytes after %.0f updates; %.0f scans needed the recovery search\n",
+              frontend->map_bytes(), c["map_updates"], c["scans_searched"]);
   if (t.error_m >= 0.0) {
     std::printf("position error: %.4f m (%s)\n", t.error_m,
                 log_path.empty() ? "final, synthetic" : "RMS against ground truth");
@@ -208,9 +210,8 @@ int main(int argc, char** argv) {
       "%d, "
       "\"per_scan_median_ms\": %.3f, \"per_scan_p99_ms\": %.3f, \"per_scan_mean_ms\": %.3f, "
       "\"per_scan_max_ms\": %.3f, \"scanner_rate_hz\": %.2f, \"real_time_factor\": %.2f, "
-      "\"map_bytes\": %zu, \"map_updates\": %lld, \"position_error_m\": %.5f}\n",
+      "\"map_bytes\": %zu, \"map_updates\": %.0f, \"position_error_m\": %.5f}\n",
       log_path.empty() ? "synthetic" : "log", t.ms.size(), t.points, t.matched_points, median, p99,
-      mean, sorted.back(), t.rate_hz, rtf, frontend.map_memory_bytes(),
-      static_cast<long long>(c.map_updates), t.error_m);
+      mean, sorted.back(), t.rate_hz, rtf, frontend->map_bytes(), c["map_updates"], t.error_m);
   return 0;
 }

@@ -2,12 +2,12 @@
 // keys listed once in each `visit`. Lengths m, angles rad, times us.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
 
 #include "channels.hpp"
+#include "pose_config.hpp"
 
 namespace traverse::frontend {
 
@@ -128,9 +128,9 @@ struct MatcherConfig {
   // step prior of the steps into and out of the pose, minus sparse_lag_long_weight per point
   // at 0.3 m beyond 1.25 times the log's usual step (90th percentile of the last 30). The
   // other pose is taken if it scores sparse_lag_margin per point more; scan k's map update then
-  // moves (undone exactly, see OccupancyGrid's journal), and scan k+1 is matched again. On
+  // moves (undone exactly, map and motion model alike), and scan k+1 is matched again. On
   // intel, scan 761 was matched 0.73 m short and 20 degrees off (the largest jump, 0.87 m); the
-  // lag moves it and the largest jump is 0.47 m (scripts/eval-carmen.sh intel --stages frontend,
+  // lag moves it and the largest jump is 0.45 m (scripts/eval-carmen.sh intel --stages frontend,
   // with and without). The frontend publishes each pose one scan late on such logs (a second
   // there); false gives each pose at once.
   bool sparse_lag = true;
@@ -195,30 +195,16 @@ struct DeskewConfig {
   }
 };
 
-// A planar pose T_parent_child: an extrinsic, or a pose in the map frame.
-struct Extrinsic2Config {
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double theta_rad = 0.0;
-
-  template <class V>
-  void visit(V& v) {
-    v("x_m", x_m);
-    v("y_m", y_m);
-    v("theta_rad", theta_rad);
-  }
-};
-
 struct FrontendConfig {
   std::string scan_channel = channels::kScanHorizontal;
   std::string imu_channel = channels::kImu;
   std::string pose_channel = channels::kPoseFrontend;
-  Extrinsic2Config T_base_laser;
+  Pose2Config T_base_laser;  // the horizontal scanner in the base frame
   // Pose of the base at the first scan in the map frame, T_map_base: where the trajectory starts
   // in a site's frame (a surveyed start point). The map's grid is aligned with the map frame, so
   // a sub-cell offset or a small turn here also changes how every scan falls on the cells
   // (scripts/frontend-sensitivity.sh measures what that does to a trajectory).
-  Extrinsic2Config initial_pose;
+  Pose2Config initial_pose;
   MapConfig map;
   MatcherConfig matcher;
   DeskewConfig deskew;
@@ -236,48 +222,10 @@ struct FrontendConfig {
   }
 };
 
-// The values a frontend cannot run with, named; nullopt when the config is usable.
-inline std::optional<std::string> config_problem(const FrontendConfig& c) {
-  if (!(std::isfinite(c.initial_pose.x_m) && std::isfinite(c.initial_pose.y_m) &&
-        std::isfinite(c.initial_pose.theta_rad)))
-    return "initial_pose must be finite";
-  if (!(c.map.resolution_m >= 0.005)) return "map.resolution_m must be at least 0.005";
-  if (c.map.levels < 1 || c.map.levels > 8) return "map.levels must be 1 to 8";
-  if (!(c.map.p_occupied > 0.5 && c.map.p_occupied < 1.0))
-    return "map.p_occupied must be in (0.5, 1)";
-  if (!(c.map.p_free > 0.0 && c.map.p_free < 0.5)) return "map.p_free must be in (0, 0.5)";
-  if (c.map.max_bytes <= 0) return "map.max_bytes must be positive";
-  if (c.matcher.iterations_coarse < 1 || c.matcher.iterations_fine < 1)
-    return "matcher.iterations_coarse and iterations_fine must be at least 1";
-  if (!(c.matcher.prior_sigma_xy_m > 0.0 && c.matcher.prior_sigma_theta_rad > 0.0))
-    return "matcher.prior_sigma_xy_m and prior_sigma_theta_rad must be positive";
-  if (!(c.matcher.max_range_m > c.matcher.min_range_m))
-    return "matcher.max_range_m must exceed min_range_m";
-  if (!(c.matcher.search_linear_window_m > 0.0 && c.matcher.search_angular_window_rad > 0.0))
-    return "matcher.search_linear_window_m and search_angular_window_rad must be positive";
-  if (!(c.matcher.search_max_unverified_m >= 0.0 && c.matcher.search_max_unverified_rad >= 0.0))
-    return "matcher.search_max_unverified_m and search_max_unverified_rad must not be negative";
-  if (!(c.matcher.wide_search_linear_window_m > 0.0 &&
-        c.matcher.wide_search_angular_window_rad > 0.0 &&
-        c.matcher.wide_search_angular_window_rad <= 3.1416))
-    return "matcher.wide_search_linear_window_m must be positive and "
-           "wide_search_angular_window_rad in (0, pi]";
-  if (c.matcher.wide_search_gap_us <= 0) return "matcher.wide_search_gap_us must be positive";
-  if (c.matcher.sparse_ensemble_members < 1 || c.matcher.sparse_ensemble_members > 16)
-    return "matcher.sparse_ensemble_members must be 1 to 16";
-  if (!(c.matcher.wide_search_temperature >= 0.0))
-    return "matcher.wide_search_temperature must not be negative";
-  if (!(c.matcher.sparse_step_min_travel_m > 0.0 && c.matcher.sparse_step_min_turn_rad > 0.0))
-    return "matcher.sparse_step_min_travel_m and sparse_step_min_turn_rad must be positive";
-  if (!(c.matcher.sparse_step_short_weight >= 0.0 && c.matcher.sparse_step_off_arc_weight >= 0.0 &&
-        c.matcher.sparse_step_off_arc_free_m >= 0.0))
-    return "matcher.sparse_step_short_weight, sparse_step_off_arc_weight and "
-           "sparse_step_off_arc_free_m must not be negative";
-  if (!(c.matcher.sparse_lag_window_m > 0.0 && c.matcher.sparse_lag_window_rad > 0.0))
-    return "matcher.sparse_lag_window_m and sparse_lag_window_rad must be positive";
-  if (!(c.matcher.sparse_lag_long_weight >= 0.0 && c.matcher.sparse_lag_margin >= 0.0))
-    return "matcher.sparse_lag_long_weight and sparse_lag_margin must not be negative";
-  return std::nullopt;
-}
+// The values a frontend cannot run with, named by key; nullopt when the config is usable.
+std::optional<std::string> validate(const MapConfig& config);
+std::optional<std::string> validate(const MatcherConfig& config);
+std::optional<std::string> validate(const DeskewConfig& config);
+std::optional<std::string> validate(const FrontendConfig& config);
 
 }  // namespace traverse::frontend

@@ -6,7 +6,7 @@
 namespace traverse::frontend {
 
 FrontendNode::FrontendNode(Bus& bus, const FrontendConfig& config, CounterSink counters)
-    : bus_(bus), config_(config), frontend_(config), counters_(std::move(counters)) {
+    : bus_(bus), config_(config), frontend_(make_frontend(config)), counters_(std::move(counters)) {
   bus_.subscribe<planar_scan_t>(config_.scan_channel,
                                 [this](const planar_scan_t& m) { on_scan(m); });
   bus_.subscribe<imu_t>(config_.imu_channel, [this](const imu_t& m) { on_imu(m); });
@@ -18,25 +18,26 @@ void FrontendNode::on_scan(const planar_scan_t& msg) {
 }
 
 void FrontendNode::on_imu(const imu_t& msg) {
-  frontend_.add_imu(msg.utime, Eigen::Vector3d(msg.angular_velocity[0], msg.angular_velocity[1],
-                                               msg.angular_velocity[2]));
+  const Eigen::Vector3d angular_velocity(msg.angular_velocity[0], msg.angular_velocity[1],
+                                         msg.angular_velocity[2]);
+  if (frontend_->add_imu(msg.utime, angular_velocity)) last_imu_utime_ = msg.utime;
   flush();
 }
 
 void FrontendNode::flush(bool all) {
-  const auto last_imu = frontend_.last_imu_utime();
+  const auto& last_imu = last_imu_utime_;
   while (!pending_.empty()) {
     const Scan& scan = pending_.front();
     const bool ready = all || !last_imu || *last_imu >= scan.utime_last ||
                        pending_.back().utime_last - scan.utime_last >= config_.deskew.imu_wait_us;
     if (!ready) break;
-    const FrontendResult result = frontend_.process(scan);
+    const FrontendResult result = frontend_->process(scan);
     pending_.pop_front();
     if (result.has_pose()) publish(result);
   }
   if (!all) return;
   // The end of the stream: the scan the lag still holds (sparse_lag) gets its pose.
-  if (const auto result = frontend_.finish()) publish(*result);
+  if (const auto result = frontend_->finish()) publish(*result);
 }
 
 void FrontendNode::publish(const FrontendResult& result) {
@@ -56,23 +57,9 @@ void FrontendNode::publish(const FrontendResult& result) {
 
 void FrontendNode::report_counters() {
   if (!counters_) return;
-  const FrontendCounters& c = frontend_.counters();
-  counters_("scans_received", static_cast<double>(c.scans_received));
-  counters_("scans_matched", static_cast<double>(c.scans_matched));
-  counters_("scans_predicted", static_cast<double>(c.scans_predicted));
-  counters_("scans_unverified", static_cast<double>(c.scans_unverified));
-  counters_("scans_searched", static_cast<double>(c.scans_searched));
-  counters_("scans_dropped_time", static_cast<double>(c.scans_dropped_time));
+  frontend_->report(counters_);
   counters_("scans_waiting_for_imu", static_cast<double>(pending_.size()));
-  counters_("readings_invalid", static_cast<double>(c.readings_invalid));
-  counters_("map_updates", static_cast<double>(c.map_updates));
-  counters_("map_tiles_evicted", static_cast<double>(c.map_tiles_evicted));
-  counters_("map_bytes", static_cast<double>(frontend_.map_memory_bytes()));
-  counters_("imu_samples", static_cast<double>(c.imu_samples));
-  counters_("imu_dropped", static_cast<double>(c.imu_dropped_time));
-  counters_("steps_disputed", static_cast<double>(c.steps_disputed));
-  counters_("steps_outvoted", static_cast<double>(c.steps_outvoted));
-  counters_("scans_revised", static_cast<double>(c.scans_revised));
+  counters_("map_bytes", static_cast<double>(frontend_->map_bytes()));
 }
 
 }  // namespace traverse::frontend

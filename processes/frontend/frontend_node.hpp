@@ -1,13 +1,17 @@
-// Adapts LCM messages to the frontend: planar_scan_t and imu_t in, pose2d_t out (parent "map",
-// child "base", one per scan). A scan waits until IMU samples cover its last point (or until a
-// scan imu_wait_us later has arrived, or for good when no IMU publishes), because a log player
-// delivers a sweep at its first point's time, before the IMU samples taken during the sweep.
-// On a log subsampled by travel a pose comes one scan late (MatcherConfig::sparse_lag), the last
-// one at shutdown (flush(true)).
+// Adapts LCM messages to the frontend (frontend.hpp, made by make_frontend()): planar_scan_t and
+// imu_t in, pose2d_t out (parent "map", child "base", one per scan, FLAG_PREDICTED when the
+// frontend says kPredicted), the frontend's counters into the process status. A scan waits until
+// IMU samples cover its last point (or until a scan imu_wait_us later has arrived, or for good when
+// no IMU publishes), because a log player delivers a sweep at its first point's time, before the
+// IMU samples taken during the sweep. A frontend may give a pose a scan late (on a log subsampled
+// by travel: MatcherConfig:: sparse_lag), the last one at shutdown (flush(true)).
 #pragma once
 
+#include <cstdint>
 #include <deque>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "bus.hpp"
@@ -27,7 +31,7 @@ class FrontendNode {
   void flush(bool all = false);
   // Copies the frontend's counters to the sink (status counters of the process).
   void report_counters();
-  const Frontend& frontend() const { return frontend_; }
+  const Frontend& frontend() const { return *frontend_; }
 
  private:
   void on_scan(const planar_scan_t& msg);
@@ -36,9 +40,10 @@ class FrontendNode {
 
   Bus& bus_;
   FrontendConfig config_;
-  Frontend frontend_;
+  std::unique_ptr<Frontend> frontend_;
   CounterSink counters_;
   std::deque<Scan> pending_;
+  std::optional<int64_t> last_imu_utime_;  // [us] of the newest IMU sample the frontend took
 };
 
 }  // namespace traverse::frontend

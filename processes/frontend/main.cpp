@@ -1,8 +1,6 @@
-// traverse-frontend: Hector-style scan-to-map matcher. Subscribes to planar scans and IMU samples,
-// publishes one pose per scan (map -> base) with its covariance (on a log subsampled by travel,
-// one scan late: matcher.sparse_lag).
-#include <spdlog/spdlog.h>
-
+// traverse-frontend: the frontend (frontend.hpp; the Hector scan-to-map matcher as configured).
+// Subscribes to planar scans and IMU samples, publishes one pose per scan (map -> base) with its
+// covariance (on a log subsampled by travel, one scan late: matcher.sparse_lag).
 #include "frontend_node.hpp"
 #include "process.hpp"
 
@@ -11,11 +9,7 @@ int main(int argc, char** argv) {
                          "Hector-style scan-to-map matcher: one pose per scan with covariance");
   traverse::frontend::FrontendConfig config;
   proc.offer_replay();
-  if (auto rc = proc.start(argc, argv, config)) return *rc;
-  if (auto problem = traverse::frontend::config_problem(config)) {
-    spdlog::error("traverse-frontend: config error: {}: {}", proc.config_path(), *problem);
-    return traverse::kConfigErrorExitCode;
-  }
+  if (auto rc = proc.start(argc, argv, config)) return *rc;  // validate(config) included
   traverse::frontend::FrontendNode node(
       proc.bus(), config, [&proc](const std::string& name, double v) { proc.counter(name) = v; });
   const int rc = proc.spin([&node] { node.report_counters(); });

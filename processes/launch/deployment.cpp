@@ -15,6 +15,12 @@
 
 namespace traverse::launch {
 
+std::optional<std::string> validate(const StageSpec& s) {
+  ConfigCheck check;
+  check.in_range("stop_timeout_s", s.stop_timeout_s, 0.0, 3600.0);
+  return check.problem();
+}
+
 Deployment load_deployment(const std::string& path) {
   Deployment d;
   load_config(path, d);
@@ -30,6 +36,7 @@ Deployment load_deployment(const std::string& path) {
     if (!names.insert(s.name).second) {
       throw ConfigError(where + ": name '" + s.name + "' used twice");
     }
+    if (const auto problem = validate(s)) throw ConfigError(where + ": " + *problem);
   }
   return d;
 }

@@ -34,6 +34,9 @@ struct StageSpec {
   }
 };
 
+// The first value out of range, named by its key; nullopt when the stage is usable.
+std::optional<std::string> validate(const StageSpec& stage);
+
 struct Deployment {
   std::vector<StageSpec> processes;
 

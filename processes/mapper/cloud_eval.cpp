@@ -5,6 +5,8 @@
 #include <cmath>
 #include <map>
 
+#include "config.hpp"
+
 namespace traverse::mapper {
 
 void transform_cloud(std::vector<CloudPoint>& cloud, const Pose2& T_world_map) {
@@ -64,20 +66,35 @@ std::optional<Eigen::Vector2d> fit_circle(const std::vector<Eigen::Vector2d>& pt
   return c;
 }
 
-std::string check_corridors(const std::vector<CorridorSpec>& corridors) {
-  for (const CorridorSpec& c : corridors) {
-    for (const WallProbe* w : {&c.end_a, &c.end_b}) {
-      const std::string where = "corridor " + c.name + (w == &c.end_a ? " end_a" : " end_b");
-      if (w->axis != "x" && w->axis != "y") return where + ": axis must be x or y";
-      if (w->across.empty()) return where + ": across needs at least one interval [lo, hi]";
-      for (const auto& iv : w->across) {
-        if (iv.size() != 2 || !(iv[0] < iv[1])) {
-          return where + ": every across interval must be [lo, hi] with lo < hi (metres)";
-        }
-      }
-    }
+std::optional<std::string> validate(const WallProbe& w) {
+  ConfigCheck check;
+  check.require(w.axis == "x" || w.axis == "y", "axis", "must be x or y, not '" + w.axis + "'");
+  check.require(!w.across.empty(), "across", "needs at least one interval [lo, hi]");
+  for (std::size_t i = 0; i < w.across.size(); ++i) {
+    const std::vector<double>& iv = w.across[i];
+    check.require(iv.size() == 2 && iv[0] < iv[1], "across[" + std::to_string(i) + "]",
+                  "must be an interval [lo, hi] with lo < hi (metres)");
   }
-  return {};
+  return check.problem();
+}
+
+std::optional<std::string> validate(const CloudEvalConfig& c) {
+  ConfigCheck check;
+  check.positive("max_search_m", c.max_search_m);
+  check.positive("histogram_bin_m", c.histogram_bin_m);
+  check.require(c.max_search_m / c.histogram_bin_m <= 1e7, "histogram_bin_m",
+                "must be at least max_search_m / 1e7");
+  check.positive("pillar_band_m", c.pillar_band_m);
+  check.positive("pillar_trim_m", c.pillar_trim_m);
+  check.in_range("pillar_min_points", c.pillar_min_points, 3, 1'000'000'000);
+  check.require(c.z_max_m > c.z_min_m, "z_max_m", "must exceed z_min_m");
+  check.positive("wall_band_m", c.wall_band_m);
+  for (std::size_t i = 0; i < c.corridors.size(); ++i) {
+    const std::string key = "corridors[" + std::to_string(i) + "]";
+    check.nested(key + ".end_a", validate(c.corridors[i].end_a));
+    check.nested(key + ".end_b", validate(c.corridors[i].end_b));
+  }
+  return check.problem();
 }
 
 namespace {

@@ -90,8 +90,9 @@ struct CorridorResult {
   int points_a = 0, points_b = 0;  // cloud points near each end wall
 };
 
-// Empty if every probe of every corridor is valid; else what is wrong, naming the corridor.
-std::string check_corridors(const std::vector<CorridorSpec>& corridors);
+// The first value out of range, named by its key path; nullopt when the config is usable.
+std::optional<std::string> validate(const WallProbe& probe);
+std::optional<std::string> validate(const CloudEvalConfig& config);
 
 struct CloudEvalResult {
   Stats surface;  // point-to-surface distances [m]

@@ -87,8 +87,8 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
     return traverse::kConfigErrorExitCode;
   }
-  if (const std::string bad = traverse::mapper::check_corridors(config.corridors); !bad.empty()) {
-    spdlog::error("{}: {}", config_file, bad);
+  if (const auto problem = traverse::mapper::validate(config)) {
+    spdlog::error("{}: {}", config_file.empty() ? "default config" : config_file, *problem);
     return traverse::kConfigErrorExitCode;
   }
   std::string error;

@@ -23,21 +23,13 @@ int main(int argc, char** argv) {
   std::string out_dir;
   proc.cli().add_option("--out", out_dir, "export folder (overrides output_dir of the config)");
   proc.offer_replay();
-  if (auto rc = proc.start(argc, argv, config)) return *rc;
+  if (auto rc = proc.start(argc, argv, config)) return *rc;  // validate(config) included
   if (!out_dir.empty()) config.output_dir = out_dir;
   traverse::sim::RigConfig rig;
   try {
     traverse::load_config(config.rig_file, rig);
   } catch (const traverse::ConfigError& e) {
     spdlog::error("{} (rig_file of {})", e.what(), proc.config_path());
-    return traverse::kConfigErrorExitCode;
-  }
-  if (config.resolution_m <= 0 || config.range_max_m <= config.range_min_m ||
-      config.poses_per_segment < 1 || config.move_threads < 1) {
-    spdlog::error(
-        "{}: need resolution_m > 0, range_max_m > range_min_m, poses_per_segment >= 1, "
-        "move_threads >= 1",
-        proc.config_path());
     return traverse::kConfigErrorExitCode;
   }
   std::signal(SIGUSR1, on_usr1);

@@ -5,7 +5,35 @@
 #include <iterator>
 #include <thread>
 
+#include "config.hpp"
+
 namespace traverse::mapper {
+
+std::optional<std::string> validate(const Footprint& f) {
+  ConfigCheck check;
+  check.require(f.x_max >= f.x_min, "x_max", "must be at least x_min");
+  check.require(f.y_max >= f.y_min, "y_max", "must be at least y_min");
+  check.require(f.z_max >= f.z_min, "z_max", "must be at least z_min");
+  return check.problem();
+}
+
+std::optional<std::string> validate(const MapperConfig& c) {
+  ConfigCheck check;
+  check.in_range("resolution_m", c.resolution_m, 0.001, 10.0);
+  check.not_negative("range_min_m", c.range_min_m);
+  check.require(c.range_max_m > c.range_min_m, "range_max_m", "must exceed range_min_m");
+  // OctoMap keys are 16 bits per axis: a point farther than this many leaves from the origin has
+  // none.
+  check.require(c.range_max_m / c.resolution_m < 30000.0, "range_max_m",
+                "must be under 30000 leaves of resolution_m");
+  check.nested("footprint", validate(c.footprint));
+  check.not_empty("rig_file", c.rig_file);
+  check.not_empty("output_dir", c.output_dir);
+  check.in_range("poses_per_segment", c.poses_per_segment, 1, 1'000'000);
+  check.positive("max_pending_s", c.max_pending_s);
+  check.in_range("move_threads", c.move_threads, 1, 64);
+  return check.problem();
+}
 
 namespace {
 

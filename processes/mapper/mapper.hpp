@@ -28,6 +28,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -80,6 +81,10 @@ struct MapperConfig {
 };
 
 // A profile of the tilted scanner as measured: the common scan plus its intensities.
+// The first value out of range, named by its key; nullopt when the config is usable.
+std::optional<std::string> validate(const Footprint& footprint);
+std::optional<std::string> validate(const MapperConfig& config);
+
 struct Profile : PlanarScan {
   std::vector<uint8_t> intensities;  // [0..255], empty or one per range
 };

@@ -68,8 +68,8 @@ int main(int argc, char** argv) {
   if (!config_path.empty()) {
     try {
       traverse::load_config(config_path, config);
-      if (const std::string error = traverse::backend::validate(config); !error.empty()) {
-        throw traverse::ConfigError(config_path + ": " + error);
+      if (const auto problem = traverse::backend::validate(config)) {
+        throw traverse::ConfigError(config_path + ": " + *problem);
       }
     } catch (const traverse::ConfigError& e) {
       std::cerr << "traverse-pgo: " << e.what() << '\n';

@@ -79,12 +79,8 @@ int main(int argc, char** argv) {
       ->excludes(out_opt);
 
   sim::SimConfig cfg;
+  // validate(cfg) included.
   if (auto rc = proc.start(argc, argv, cfg, !has_out_option(argc, argv))) return *rc;
-  if (auto error = sim::validate(cfg)) {
-    spdlog::error("traverse-sim: config error: {} (in {})", *error,
-                  proc.config_path().empty() ? "defaults" : proc.config_path());
-    return kConfigErrorExitCode;
-  }
   if (wheel_encoders) cfg.effects.wheel_encoders.enabled = true;
   const bool realistic = profile == "realistic";
   const sim::Effects effects = realistic ? cfg.effects : cfg.effects.ideal();

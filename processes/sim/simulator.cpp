@@ -81,6 +81,13 @@ std::optional<std::string> validate(const SimConfig& c) {
   check.in_range("platform.yaw_accel_radps2", c.platform.yaw_accel_radps2, 0.01, 10.0);
   check.in_range("platform.half_track_m", c.platform.half_track_m, 0.05, 2.0);
   check.positive("platform.vibration_ref_speed_mps", c.platform.vibration_ref_speed_mps);
+  for (std::size_t i = 0; i < c.platform.vibration.size(); ++i) {
+    const VibrationSpec& vib = c.platform.vibration[i];
+    const std::string key = "platform.vibration[" + std::to_string(i) + "].";
+    check.require(vib.axis == "x" || vib.axis == "y" || vib.axis == "yaw", key + "axis",
+                  "must be x, y or yaw, got '" + vib.axis + "'");
+    check.positive(key + "wavelength_m", vib.wavelength_m);
+  }
   return check.problem();
 }
 

@@ -1,11 +1,25 @@
 #include "monitor_node.hpp"
 
 #include "channels.hpp"
+#include "config.hpp"
 #include "message_checks.hpp"
 #include "process.hpp"
 #include "traverse/process_status_t.hpp"
 
 namespace traverse {
+
+std::optional<std::string> validate::validate(const MonitorConfig& c) {
+  ConfigCheck check;
+  check.positive("status_timeout_s", c.status_timeout_s);
+  check.positive("max_status_gap_s", c.max_status_gap_s);
+  check.not_negative("max_missed", c.max_missed);
+  check.not_negative("max_out_of_order", c.max_out_of_order);
+  check.not_negative("max_queue_dropped", c.max_queue_dropped);
+  check.not_negative("max_rejected", c.max_rejected);
+  check.not_negative("max_seq_gaps", c.max_seq_gaps);
+  return check.problem();
+}
+
 namespace {
 
 const std::string kStatusPrefix = "STATUS_";

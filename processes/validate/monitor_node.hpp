@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
+#include <optional>
 #include <string>
 
 #include "bus.hpp"
@@ -13,6 +14,8 @@
 #include "stream_analyzer.hpp"
 
 namespace traverse {
+
+namespace validate {
 
 // The verdict's thresholds: a run is ok only when every figure is within them (the defaults
 // allow no loss at all; a clean run on one host loses nothing).
@@ -23,7 +26,8 @@ struct MonitorConfig {
   int64_t max_out_of_order = 0;   // [messages] a process dropped as stamped before the last one
   int64_t max_queue_dropped = 0;  // [messages] a process's receive queue dropped
   int64_t max_rejected = 0;       // [messages] a process rejected or dropped as stamp outliers
-  int64_t max_seq_gaps = 0;       // [messages] the monitor itself missed on a channel
+  int64_t max_seq_gaps = 0;       // [messages] the monitor itself missed on a channel: above
+                                  // it a note (its own reception), not a failed run
 
   template <class V>
   void visit(V& v) {
@@ -36,6 +40,12 @@ struct MonitorConfig {
     v("max_seq_gaps", max_seq_gaps);
   }
 };
+
+// The first value out of range, named by its key; nullopt when the config is valid.
+std::optional<std::string> validate(const MonitorConfig& config);
+
+}  // namespace validate
+using validate::MonitorConfig;
 
 class MonitorNode {
  public:

@@ -30,7 +30,7 @@ class BackendNodeTest : public ::testing::Test {
  protected:
   // Feeds a drive through the node over memq:// and collects its output.
   void run(const BackendNodeConfig& config, double duration_s) {
-    ASSERT_EQ(validate(config), "");
+    ASSERT_EQ(validate(config), std::nullopt);
     BackendNode node(bus_, config, [this](const std::string& k, double v) { counters_[k] = v; });
     bus_.subscribe<key_poses_t>(channels::kKeyPoses,
                                 [this](const key_poses_t& m) { messages_.push_back(m); });

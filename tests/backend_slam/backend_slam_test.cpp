@@ -19,7 +19,7 @@ double rms(const std::vector<double>& v) {
 // Runs a drifting frontend through the backend; returns the RMS position error of the key poses
 // of the input and of the backend [m].
 std::pair<double, double> run_drive(const test::Drive& d, const BackendConfig& config) {
-  EXPECT_EQ(validate(config), "");
+  EXPECT_EQ(validate(config), std::nullopt);
   Backend backend(config);
   int updates = 0;
   for (std::size_t k = 0; k < d.utimes.size(); ++k) {
@@ -98,12 +98,20 @@ TEST(Backend, SmoothsAFrontendJumpAway) {
 
 TEST(Backend, ConfigValidation) {
   BackendConfig config;
-  EXPECT_EQ(validate(config), "");
+  EXPECT_EQ(validate(config), std::nullopt);
   config.link.resolution_m = -1.0;
-  EXPECT_NE(validate(config).find("link."), std::string::npos);
+  ASSERT_TRUE(validate(config));
+  EXPECT_NE(validate(config)->find("key 'link."), std::string::npos);
   config = BackendConfig{};
   config.optimize_every = 0;
-  EXPECT_FALSE(validate(config).empty());
+  EXPECT_TRUE(validate(config));
+  // A key pose at least every 0 or -1 us is no interval.
+  for (const int64_t interval_us : {0, -1}) {
+    config = BackendConfig{};
+    config.key_poses.interval_us = interval_us;
+    ASSERT_TRUE(validate(config));
+    EXPECT_NE(validate(config)->find("key 'key_poses.interval_us'"), std::string::npos);
+  }
 }
 
 }  // namespace

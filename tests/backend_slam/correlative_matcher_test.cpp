@@ -84,8 +84,8 @@ TEST(CorrelativeMatcher, EmptyInputIsInvalid) {
   EXPECT_FALSE(matcher.match({{1.0, 0.0}}, {}, Pose2()).valid);
   CorrelativeMatcherConfig bad;
   bad.resolution_m = 0.0;
-  EXPECT_FALSE(validate(bad).empty());
-  EXPECT_TRUE(validate(CorrelativeMatcherConfig{}).empty());
+  EXPECT_TRUE(validate(bad));
+  EXPECT_FALSE(validate(CorrelativeMatcherConfig{}));
 }
 
 }  // namespace

@@ -5,7 +5,6 @@
 // times 0.3 s apart, whole seconds as runs 1 us apart, 32.76 m readings as hundreds of points on a
 // circle round the robot, and a 100,000-beam scan as it came.
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <chrono>
 #include <filesystem>
@@ -13,8 +12,11 @@
 #include <thread>
 
 #include "bus.hpp"
+#include "carmen_config.hpp"
 #include "channels.hpp"
+#include "config.hpp"
 #include "crafted_logs.hpp"
+#include "frontend_config.hpp"
 #include "program.hpp"
 #include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
@@ -26,16 +28,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The frontend's gap beyond which scans are matched as sparse (configs/frontend.yaml), and the
-// driver's nominal spacing (configs/carmen.yaml): a log without time must look sparse.
+// The frontend's gap beyond which scans are matched as sparse, and the driver's nominal spacing,
+// as the shipped configs set them (or default them): a log without time must look sparse.
 int64_t frontend_sparse_gap_us() {
-  return YAML::LoadFile("configs/frontend.yaml")["matcher"]["wide_search_gap_us"].as<int64_t>();
+  frontend::FrontendConfig frontend;
+  load_config("configs/frontend.yaml", frontend);
+  return frontend.matcher.wide_search_gap_us;
 }
 
 TEST(CarmenConfigs, NominalSpacingIsSparseForTheFrontend) {
-  const double period_s =
-      YAML::LoadFile("configs/carmen.yaml")["nominal_scan_period_s"].as<double>();
-  EXPECT_GT(period_s * 1e6, static_cast<double>(frontend_sparse_gap_us()));
+  carmen::CarmenConfig driver;
+  load_config("configs/carmen.yaml", driver);
+  EXPECT_GT(driver.nominal_scan_period_s * 1e6, static_cast<double>(frontend_sparse_gap_us()));
 }
 
 struct TimeCase {

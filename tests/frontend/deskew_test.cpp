@@ -1,11 +1,11 @@
-#include "deskew.hpp"
+#include "hector/deskew.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 
+#include "hector/yaw_integrator.hpp"
 #include "synthetic_scans.hpp"
-#include "yaw_integrator.hpp"
 
 namespace traverse::frontend {
 namespace {

@@ -1,4 +1,4 @@
-#include "occupancy_grid.hpp"
+#include "hector/occupancy_grid.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,11 @@
-#include "scan_matcher.hpp"
+#include "hector/scan_matcher.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <cstdio>
 
+#include "hector/grid_search.hpp"
 #include "test_scans.hpp"
 
 namespace traverse::frontend {

@@ -2,10 +2,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <map>
 #include <random>
+#include <string>
 #include <vector>
 
-#include "scan_matcher.hpp"
+#include "frontend.hpp"
+#include "hector/scan_matcher.hpp"
 #include "synthetic_scans.hpp"
 
 namespace traverse::frontend::testing {
@@ -28,6 +31,13 @@ inline std::vector<Eigen::Vector2d> static_scan(const synthetic::World& world,
     points.emplace_back(range * std::cos(a), range * std::sin(a));
   }
   return points;
+}
+
+// Every status counter a frontend reports, by name.
+inline std::map<std::string, double> counters_of(const Frontend& frontend) {
+  std::map<std::string, double> counters;
+  frontend.report([&](const std::string& name, double value) { counters[name] = value; });
+  return counters;
 }
 
 // A map pyramid (map frame = world frame) built from scans taken at the given poses.

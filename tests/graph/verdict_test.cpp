@@ -72,9 +72,9 @@ TEST(Verdict, OfflineRunOnRandomBytesOrAnEmptyLogFails) {
     std::ofstream empty(dir / "empty.lcmlog");
   }
   for (const char* name : {"random.lcmlog", "empty.lcmlog"}) {
-    const auto r = run(run_graph(dir / name, dir / (std::string(name) + ".run"),
-                                 "--offline --stages frontend"),
-                       60);
+    const auto r = run(
+        run_graph(dir / name, dir / (std::string(name) + ".run"), "--offline --stages frontend"),
+        60);
     EXPECT_EQ(r.exit_code, 3) << name << "\n" << r.output;
     EXPECT_NE(r.output.find("no readable event"), std::string::npos) << r.output;
   }
@@ -98,16 +98,15 @@ TEST(Verdict, AStoppedFrontendFailsTheLiveRun) {
 TEST(Verdict, EveryProcessReadsAndChecksTheInputSection) {
   const auto dir = temp_dir("input-section");
   std::ofstream(dir / "empty.lcmlog");
-  for (const auto& [section, expected] :
-       std::vector<std::pair<std::string, std::string>>{
-           {"input:\n  max_scan_beams: 0\n", "key 'max_scan_beams' must be positive"},
+  for (const auto& [section, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"input:\n  max_scan_beams: 0\n", "key 'input.max_scan_beams' must be positive"},
            {"input:\n  max_scan_beamz: 5\n", "unknown key 'input.max_scan_beamz'"},
            {"input:\n  max_stamp_jump_s: 60\n", ""}}) {
     std::ofstream(dir / "densifier.yaml") << section;
-    const auto r = run(bin_dir() + "/traverse-densifier --config " +
-                           (dir / "densifier.yaml").string() + " --replay " +
-                           (dir / "empty.lcmlog").string(),
-                       30);
+    const auto r =
+        run(bin_dir() + "/traverse-densifier --config " + (dir / "densifier.yaml").string() +
+                " --replay " + (dir / "empty.lcmlog").string(),
+            30);
     EXPECT_EQ(r.exit_code, expected.empty() ? 0 : 2) << r.output;
     EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
   }

@@ -100,17 +100,21 @@ TEST(CloudEval, EndWallIsProbedOnlyInsideItsIntervals) {
 }
 
 TEST(CloudEval, BadCorridorIntervalsAreNamed) {
-  std::vector<CorridorSpec> c = {{"lower", {"x", 0.0, {{0.2, 2.2}}}, {"x", 44.0, {{-1.8, -0.2}}}}};
-  EXPECT_EQ(check_corridors(c), "");
+  CloudEvalConfig config;
+  config.corridors = {{"lower", {"x", 0.0, {{0.2, 2.2}}}, {"x", 44.0, {{-1.8, -0.2}}}}};
+  std::vector<CorridorSpec>& c = config.corridors;
+  EXPECT_EQ(validate(config), std::nullopt);
   c[0].end_b.across = {{-0.2, -1.8}};
-  EXPECT_NE(check_corridors(c).find("corridor lower end_b"), std::string::npos);
+  ASSERT_TRUE(validate(config));
+  EXPECT_NE(validate(config)->find("key 'corridors[0].end_b.across[0]'"), std::string::npos);
   c[0].end_b.across = {{-1.8, -0.2, 0.5}};
-  EXPECT_NE(check_corridors(c), "");
+  EXPECT_TRUE(validate(config));
   c[0].end_b.across = {};
-  EXPECT_NE(check_corridors(c), "");
+  EXPECT_TRUE(validate(config));
   c[0].end_b.across = {{-1.8, -0.2}};
   c[0].end_a.axis = "z";
-  EXPECT_NE(check_corridors(c).find("end_a"), std::string::npos);
+  ASSERT_TRUE(validate(config));
+  EXPECT_NE(validate(config)->find("corridors[0].end_a.axis"), std::string::npos);
 }
 
 TEST(CloudEval, DescribeGivesTheUsualStatistics) {

@@ -1,14 +1,29 @@
-// Correlative wide search (Olson 2009) for sparse scans, on one occupancy grid.
+// The frontend's correlative searches on one occupancy grid (Olson 2009), made of the parts in
+// common/correlative_search.hpp:
+//   - the recovery search of the scan matcher (scan_matcher.hpp): exhaustive over a window on the
+//     coarsest grid, scoring occupied evidence under the points, for a new Gauss-Newton start
+//     when a match failed;
+//   - the wide search for sparse scans (below).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
+#include "correlative_search.hpp"
 #include "occupancy_grid.hpp"
 #include "se2.hpp"
+#include "step_prior.hpp"
 
 namespace traverse::frontend {
+
+// Best pose within +-linear_window_m (x, y) and +-angular_window_rad of T_center by exhaustive
+// search on `grid` (steps of one cell, and of the angle that moves the farthest point one cell),
+// scoring occupied evidence max(0, 2 (p - 0.5)) under the points (at most 200 of them, evenly
+// spaced). Of the poses within 3 % of the best score, the one nearest the centre wins, so that a
+// direction the scan cannot tell apart (a corridor's axis) keeps the centre's value.
+Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+                  const Pose2& T_center, double linear_window_m, double angular_window_rad);
 
 // Wide search for scans far from the previous one (sparse logs, no odometry): correlative
 // matching (Olson 2009) over x, y and heading by a two-level branch and bound, exact at the
@@ -18,9 +33,10 @@ namespace traverse::frontend {
 // unknown. Occupied evidence is blurred by a cell (a point one cell off still scores half), so
 // that a pose a fraction of a cell off is not scored as a miss. Angle steps move the point at the
 // 90th percentile of range by one cell. A motion prior (the score loses 0.05 per point at one
-// half-window from the nearest prior pose, quadratically) and, if given, a step prior (StepPrior,
-// below) decide where the scan cannot. With a temperature, the search also keeps every pose near
-// the best and reports their spread: how far the scores leave the pose open.
+// half-window from the nearest prior pose, quadratically) and, if given, a step prior
+// (step_prior.hpp) decide where the scan cannot: they are the search's prior hook. With a
+// temperature, the search also keeps every pose near the best and reports their spread: how far the
+// scores leave the pose open.
 struct WideSearchResult {
   Pose2 T_map_base;
   double score = 0.0;     // [unitless] mean evidence per point at the best pose, -1 to 1
@@ -33,30 +49,11 @@ struct WideSearchResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int64_t poses_in_spread = 0;  // poses within 8 temperatures of the best
 };
-// Prior on the shape of a step from T_last, for a wheeled platform whose log was subsampled by
-// travel (the CARMEN sets keep a scan when odometry has moved about 1 m or turned about 0.5 rad):
-//   - a step both shorter than min_travel_m and turning less than min_turn_rad is unlikely: it
-//     loses short_weight * s^2 per point, s = 1 - max(length / min_travel_m, |turn| /
-//     min_turn_rad) (1 standing still, 0 on the border);
-//   - wheels roll along an arc: a step off the arc through its own turn (sideways by more than
-//     off_arc_free_m, or backwards by more than that) loses off_arc_weight per point at 0.3 m
-//     beyond, quadratically.
-// It is what tells a stall (the scan fits where the last one was: along a corridor) or a slide
-// sideways from the real step where the scan cannot; where the scan can, its evidence outweighs
-// it (a point on an occupied cell against a free one is 2).
-struct StepPrior {
-  Pose2 T_last;
-  double min_travel_m = 0.0, min_turn_rad = 0.0;  // 0: no prior
-  double short_weight = 0.0;                      // [per point]
-  double off_arc_free_m = 0.0;
-  double off_arc_weight = 0.0;  // [per point]
-};
+
 // The search's score of one pose without priors: mean evidence per point, -1 to 1 (as
 // WideSearchResult::score).
 double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
                      const Pose2& T_map_base);
-// The step prior's cost per point of the step to T_map_base (0 without a prior).
-double step_prior_cost(const StepPrior& prior, const Pose2& T_map_base);
 
 WideSearchResult wide_search(const OccupancyGrid& grid,
                              const std::vector<Eigen::Vector2d>& points_base, const Pose2& T_center,

@@ -1,4 +1,4 @@
-#include "wide_search.hpp"
+#include "grid_search.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,27 +11,6 @@ constexpr double kMotionWeight = 0.05;
 // Poses scoring more than this many temperatures below the best weigh under exp(-8) = 3e-4 in the
 // score surface's spread, and are left out of it.
 constexpr double kSurfaceMargin = 8.0;
-// A step off its arc (sideways or backwards) by StepPrior::off_arc_free_m plus this loses
-// StepPrior::off_arc_weight per point, quadratically.
-constexpr double kOffArcScaleM = 0.3;
-
-// Tangent of half a step's turn: a chord of an arc turning by `turn` points half as far round
-// (sideways = forward * tan).
-double tan_half_turn(double turn) {
-  return std::tan(std::clamp(0.5 * turn, -M_PI / 4.0, M_PI / 4.0));
-}
-
-// StepPrior's cost per point of a step of `length` [m], `forward` [m] along the last heading,
-// `side` [m] off the arc through its `turn` [rad] (0 on it).
-double step_shape_cost(const StepPrior& sp, double length, double forward, double side,
-                       double turn) {
-  double cost = 0.0;
-  const double inside = 1.0 - std::max(length / sp.min_travel_m, std::abs(turn) / sp.min_turn_rad);
-  if (inside > 0.0) cost += sp.short_weight * inside * inside;
-  const double e_side = std::max(0.0, side - sp.off_arc_free_m) / kOffArcScaleM;
-  const double e_back = std::max(0.0, -forward - sp.off_arc_free_m) / kOffArcScaleM;
-  return cost + sp.off_arc_weight * (e_side * e_side + e_back * e_back);
-}
 // Evidence 2 (p - 0.5) of a cell of occupancy probability p.
 float cell_evidence(double p) { return static_cast<float>(2.0 * (p - 0.5)); }
 
@@ -45,6 +24,41 @@ float blurred_evidence(At at) {
     for (int di = -1; di <= 1; ++di) m = std::max(m, at(di, dj));
   return m > 0.0f ? std::max(at(0, 0), 0.5f * m) : at(0, 0);
 }
+
+// A search's table of the grid's cells around a centre pose: table cell (i, j) is the grid's
+// cell (cx - half + i, cy - half + j), the grid's cell of the centre (cx, cy) in the middle.
+class TableWindow {
+ public:
+  TableWindow(const OccupancyGrid& grid, const Pose2& T_center, int half)
+      : grid_(grid),
+        res_(grid.resolution()),
+        cx_(std::llround(T_center.x() / res_)),
+        cy_(std::llround(T_center.y() / res_)),
+        half_(half) {}
+  int side() const { return 2 * half_ + 1; }
+  // The table cell of a point in the map frame.
+  std::pair<int, int> operator()(const Eigen::Vector2d& q) const {
+    return {static_cast<int>(std::llround(q.x() / res_) - cx_) + half_,
+            static_cast<int>(std::llround(q.y() / res_) - cy_) + half_};
+  }
+  // The table of evidence(p) of the cells, p their occupancy probability (0.5 where unknown).
+  template <class Evidence>
+  correlative::ScoreTable table(Evidence evidence) const {
+    correlative::ScoreTable t(side(), side());
+    for (int j = 0; j < side(); ++j) {
+      for (int i = 0; i < side(); ++i) {
+        t.at(i, j) = evidence(grid_.cell_probability(cx_ - half_ + i, cy_ - half_ + j));
+      }
+    }
+    return t;
+  }
+
+ private:
+  const OccupancyGrid& grid_;
+  double res_;
+  int64_t cx_, cy_;
+  int half_;
+};
 }  // namespace
 
 double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
@@ -61,12 +75,59 @@ double pose_evidence(const OccupancyGrid& grid, const std::vector<Eigen::Vector2
   return sum / static_cast<double>(points_base.size());
 }
 
-double step_prior_cost(const StepPrior& sp, const Pose2& T_map_base) {
-  if (!(sp.min_travel_m > 0.0 && sp.min_turn_rad > 0.0)) return 0.0;
-  const Pose2 step = between(sp.T_last, T_map_base);
-  const Eigen::Vector2d v = step.translation();
-  return step_shape_cost(sp, v.norm(), v.x(), std::abs(v.y() - v.x() * tan_half_turn(step.theta())),
-                         step.theta());
+Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
+                  const Pose2& T_center, double linear_window_m, double angular_window_rad) {
+  constexpr std::size_t kMaxPoints = 200;
+  constexpr int kMaxAngles = 181;
+  const double res = grid.resolution();
+  std::vector<Eigen::Vector2d> points;
+  const std::size_t stride = std::max<std::size_t>(1, points_base.size() / kMaxPoints);
+  double r_max = res;
+  for (std::size_t i = 0; i < points_base.size(); i += stride) {
+    points.push_back(points_base[i]);
+    r_max = std::max(r_max, points_base[i].norm());
+  }
+  const double angle_step = std::max(res / r_max, 2.0 * angular_window_rad / (kMaxAngles - 1));
+  const int n_angles = static_cast<int>(std::ceil(angular_window_rad / angle_step));
+  const int n_shift = static_cast<int>(std::ceil(linear_window_m / res));
+  // A dense copy of the grid around the centre: occupied evidence max(0, 2 (p - 0.5)), so that
+  // unknown space scores nothing and free space nothing either.
+  const TableWindow window(grid, T_center, static_cast<int>(std::ceil(r_max / res)) + n_shift + 1);
+  const correlative::ScoreTable evidence =
+      window.table([](double p) { return static_cast<float>(std::max(0.0, 2.0 * (p - 0.5))); });
+  const correlative::RotatedScans scans(points, T_center, n_angles, angle_step, window);
+  // Every candidate's score; the winner is the candidate nearest the centre among those within
+  // kTolerance of the best score, so that a direction the scan cannot tell apart (a corridor's
+  // axis) keeps the centre's value instead of an arbitrary one.
+  constexpr double kTolerance = 0.03;
+  struct Candidate {
+    double score;
+    int a, dx, dy;
+  };
+  std::vector<Candidate> candidates;
+  for (int a = -n_angles; a <= n_angles; ++a) {
+    for (int dy = -n_shift; dy <= n_shift; ++dy) {
+      for (int dx = -n_shift; dx <= n_shift; ++dx) {
+        candidates.push_back({scans.sum<double>(evidence, a + n_angles, dx, dy), a, dx, dy});
+      }
+    }
+  }
+  double best_score = 0.0;
+  for (const auto& c : candidates) best_score = std::max(best_score, c.score);
+  const Candidate* best = nullptr;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (const auto& c : candidates) {
+    if (c.score < (1.0 - kTolerance) * best_score) continue;
+    const double distance = std::hypot(c.dx * res, c.dy * res) / linear_window_m +
+                            std::abs(c.a * angle_step) / angular_window_rad;
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = &c;
+    }
+  }
+  if (!best) return T_center;
+  return Pose2(T_center.x() + best->dx * res, T_center.y() + best->dy * res,
+               T_center.theta() + best->a * angle_step);
 }
 
 WideSearchResult wide_search(const OccupancyGrid& grid,
@@ -102,60 +163,20 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
   // Dense table of evidence 2 (p - 0.5) around the centre (occupied up to 1, free down to -1,
   // unknown 0), blurred by taking the larger of a cell's own evidence and half its occupied
   // neighbours'.
-  const int64_t cx = std::llround(T_center.x() / res), cy = std::llround(T_center.y() / res);
-  const int half = static_cast<int>(std::ceil(r_max / res)) + n_shift + kBlock + 2;
-  const int side = 2 * half + 1;
-  const auto at = [side](int i, int j) { return static_cast<std::size_t>(j) * side + i; };
-  std::vector<float> evidence(static_cast<std::size_t>(side) * side);
-  for (int j = 0; j < side; ++j) {
-    for (int i = 0; i < side; ++i) {
-      const double p = grid.cell_probability(cx - half + i, cy - half + j);
-      evidence[at(i, j)] = cell_evidence(p);
-    }
-  }
-  std::vector<float> table(evidence.size(), 0.0f);
+  const TableWindow window(grid, T_center,
+                           static_cast<int>(std::ceil(r_max / res)) + n_shift + kBlock + 2);
+  const int side = window.side();
+  const correlative::ScoreTable evidence = window.table(cell_evidence);
+  correlative::ScoreTable table(side, side);
   for (int j = 1; j + 1 < side; ++j) {
     for (int i = 1; i + 1 < side; ++i) {
-      table[at(i, j)] =
-          blurred_evidence([&](int di, int dj) { return evidence[at(i + di, j + dj)]; });
+      table.at(i, j) =
+          blurred_evidence([&](int di, int dj) { return evidence.at(i + di, j + dj); });
     }
   }
-  // bound(i, j) = max of table over [i, i + kBlock) x [j, j + kBlock), separably.
-  std::vector<float> rows(table.size(), 0.0f), bound(table.size(), 0.0f);
-  for (int j = 0; j < side; ++j) {
-    for (int i = 0; i + kBlock <= side; ++i) {
-      float m = -1.0f;
-      for (int b = 0; b < kBlock; ++b) m = std::max(m, table[at(i + b, j)]);
-      rows[at(i, j)] = m;
-    }
-  }
-  for (int j = 0; j + kBlock <= side; ++j) {
-    for (int i = 0; i < side; ++i) {
-      float m = -1.0f;
-      for (int b = 0; b < kBlock; ++b) m = std::max(m, rows[at(i, j + b)]);
-      bound[at(i, j)] = m;
-    }
-  }
-
-  // Cells of the points rotated by each angle, at the centre's translation.
-  const int n_points = static_cast<int>(points_base.size());
-  const int n_a = 2 * n_angles + 1;
-  std::vector<std::pair<int, int>> cells(static_cast<std::size_t>(n_a) * n_points);
-  for (int a = 0; a < n_a; ++a) {
-    const Pose2 T(T_center.x(), T_center.y(), T_center.theta() + (a - n_angles) * angle_step);
-    for (int k = 0; k < n_points; ++k) {
-      const Eigen::Vector2d q = T * points_base[k];
-      cells[static_cast<std::size_t>(a) * n_points + k] = {
-          static_cast<int>(std::llround(q.x() / res) - cx) + half,
-          static_cast<int>(std::llround(q.y() / res) - cy) + half};
-    }
-  }
-  const auto score_of = [&](const std::vector<float>& t, int a, int dx, int dy) {
-    float s = 0.0f;
-    const auto* c = &cells[static_cast<std::size_t>(a) * n_points];
-    for (int k = 0; k < n_points; ++k) s += t[at(c[k].first + dx, c[k].second + dy)];
-    return s;
-  };
+  const correlative::BlockBound bound(table, kBlock);
+  const correlative::RotatedScans scans(points_base, T_center, n_angles, angle_step, window);
+  const int n_points = scans.points();
 
   // Motion prior: poses far from every prior pose (the predictions) lose score, so that where the
   // scan cannot tell poses apart (along a corridor) a prediction wins. Per point, so the weight
@@ -181,8 +202,7 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
   // Step prior (StepPrior): per point, the smallest over a block of translations (a valid bound):
   // the step's length is largest at a corner, and its forward and sideways parts, linear in the
   // translation for one heading, are extreme at corners.
-  const bool use_step =
-      step_prior != nullptr && step_prior->min_travel_m > 0.0 && step_prior->min_turn_rad > 0.0;
+  const bool use_step = step_prior != nullptr && step_prior->active();
   const Eigen::Vector2d last_cells =
       use_step ? Eigen::Vector2d((step_prior->T_last.translation() - T_center.translation()) / res)
                : Eigen::Vector2d::Zero();
@@ -228,73 +248,50 @@ WideSearchResult wide_search(const OccupancyGrid& grid,
     return static_cast<float>(n_points * (w_motion * best_h + step_cost(a, dx, dy, size)));
   };
 
-  // Level 1: every angle and every block of translations, scored by its bound.
-  struct Candidate {
-    float bound;
-    int a, dx, dy;  // angle index, lowest translation of the block [cells]
-  };
-  std::vector<Candidate> candidates;
-  for (int a = 0; a < n_a; ++a) {
-    for (int dy = -n_shift; dy <= n_shift; dy += kBlock) {
-      for (int dx = -n_shift; dx <= n_shift; dx += kBlock) {
-        candidates.push_back({score_of(bound, a, dx, dy) - penalty(a, dx, dy, kBlock), a, dx, dy});
-      }
-    }
-  }
-  std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& l, const Candidate& r) { return l.bound > r.bound; });
-  // Level 0: blocks in order of their bound, until no block can hold a pose within `margin` of
-  // the best pose found (those poses make the score surface's spread, below).
+  // Blocks of translations in order of their bound, until no block can hold a pose within
+  // `margin` of the best pose found (those poses make the score surface's spread, below).
   const float margin = static_cast<float>(kSurfaceMargin * temperature);
-  float best = -std::numeric_limits<float>::infinity();
-  int best_a = n_angles, best_dx = 0, best_dy = 0;
   struct Scored {
     float s;
     int a, dx, dy;
   };
   std::vector<Scored> near_best;
   std::size_t kept = 0;
-  for (const Candidate& c : candidates) {
-    if (c.bound <= best - margin) break;
-    for (int dy = c.dy; dy < c.dy + kBlock && dy <= n_shift; ++dy) {
-      for (int dx = c.dx; dx < c.dx + kBlock && dx <= n_shift; ++dx) {
-        const float s = score_of(table, c.a, dx, dy) - penalty(c.a, dx, dy, 1);
-        ++result.evaluated;
-        if (temperature > 0.0 && s > best - margin) near_best.push_back({s, c.a, dx, dy});
-        if (near_best.size() > 2 * kept + 4096) {  // drop those the best has left behind
-          std::erase_if(near_best, [&](const Scored& p) { return p.s <= best - margin; });
-          kept = near_best.size();
-        }
-        if (s > best) {
-          best = s;
-          best_a = c.a;
-          best_dx = dx;
-          best_dy = dy;
-        }
-      }
+  const auto prior = [&](float sum, int a, int dx, int dy, int size) {
+    return sum - penalty(a, dx, dy, size);
+  };
+  const auto keep_near_best = [&](const correlative::ScoredPose<float>& p, float best) {
+    if (temperature > 0.0 && p.score > best - margin)
+      near_best.push_back({p.score, p.a, p.dx, p.dy});
+    if (near_best.size() > 2 * kept + 4096) {  // drop those the best has left behind
+      std::erase_if(near_best, [&](const Scored& q) { return q.s <= best - margin; });
+      kept = near_best.size();
     }
-  }
+  };
+  const auto search = correlative::branch_and_bound<float>(
+      scans, table, bound, n_shift, {-std::numeric_limits<float>::infinity(), n_angles, 0, 0},
+      margin, prior, keep_near_best);
+  result.evaluated = search.scored;
+  const float best = search.best.score;
+  const int best_a = search.best.a, best_dx = search.best.dx, best_dy = search.best.dy;
   result.T_map_base = Pose2(T_center.x() + best_dx * res, T_center.y() + best_dy * res,
                             T_center.theta() + (best_a - n_angles) * angle_step);
-  result.score = score_of(table, best_a, best_dx, best_dy) / n_points;
+  result.score = scans.sum<float>(table, best_a, best_dx, best_dy) / n_points;
 
   // Spread of the pose over the score surface: every pose within the margin of the best,
   // weighted by exp((score - best) / temperature), offsets from the best in m and rad. Taken
   // about the best pose (the one reported), not about the weighted mean: a second mode as good
   // is a second place the pose may be.
   if (temperature > 0.0) {
-    double w_sum = 0.0;
-    Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+    correlative::ScoreSpread spread;
     for (const Scored& p : near_best) {
       if (p.s <= best - margin) continue;
-      const double w = std::exp((p.s - best) / temperature);
-      const Eigen::Vector3d d((p.dx - best_dx) * res, (p.dy - best_dy) * res,
-                              wrap_angle((p.a - best_a) * angle_step));
-      w_sum += w;
-      second += w * d * d.transpose();
+      spread.add(std::exp((p.s - best) / temperature),
+                 Eigen::Vector3d((p.dx - best_dx) * res, (p.dy - best_dy) * res,
+                                 wrap_angle((p.a - best_a) * angle_step)));
       ++result.poses_in_spread;
     }
-    result.covariance = second / w_sum;
+    result.covariance = spread.about_chosen();
   }
   return result;
 }

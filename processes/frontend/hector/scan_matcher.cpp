@@ -6,64 +6,10 @@
 #include <cmath>
 #include <limits>
 
+#include "grid_search.hpp"
+#include "step_prior.hpp"
+
 namespace traverse::frontend {
-
-MapPyramid::MapPyramid(const MapConfig& config) {
-  for (int k = 0; k < std::max(1, config.levels); ++k) {
-    grids_.emplace_back(config.resolution_m * std::ldexp(1.0, k), config.p_occupied, config.p_free);
-  }
-}
-
-void MapPyramid::update(const Pose2& T_map_base, const Eigen::Vector2d& origin_base,
-                        const std::vector<Eigen::Vector2d>& hits_base) {
-  std::vector<Eigen::Vector2d> hits_map;
-  hits_map.reserve(hits_base.size());
-  for (const auto& p : hits_base) hits_map.push_back(T_map_base * p);
-  const Eigen::Vector2d origin_map = T_map_base * origin_base;
-  // Incidence of each beam on the surface it hit, the surface's direction taken from the two
-  // neighbouring points of the scan. Far apart neighbours are what a grazing beam produces; at a
-  // depth jump the "tangent" runs along the beam and also reads as grazing: the free-space update
-  // then stops early, the cautious side.
-  std::vector<double> incidence_sin(hits_base.size(), 1.0);
-  for (std::size_t i = 1; i + 1 < hits_base.size(); ++i) {
-    const Eigen::Vector2d tangent = hits_base[i + 1] - hits_base[i - 1];
-    const double length = tangent.norm();
-    if (length <= 0.0) continue;
-    const Eigen::Vector2d ray = (hits_base[i] - origin_base).normalized();
-    incidence_sin[i] = std::abs(ray.x() * tangent.y() - ray.y() * tangent.x()) / length;
-  }
-  for (auto& grid : grids_) grid.update(origin_map, hits_map, &incidence_sin);
-}
-
-std::size_t MapPyramid::memory_bytes() const {
-  std::size_t bytes = 0;
-  for (const auto& grid : grids_) bytes += grid.memory_bytes();
-  return bytes;
-}
-
-std::size_t MapPyramid::bound_memory(const Eigen::Vector2d& p_map, std::size_t max_bytes) {
-  // Each level gets a share of the budget in proportion to what it holds now.
-  const std::size_t total = memory_bytes();
-  if (total <= max_bytes) return 0;
-  std::size_t dropped = 0;
-  for (auto& grid : grids_) {
-    const double share = static_cast<double>(grid.memory_bytes()) / static_cast<double>(total);
-    dropped += grid.evict_farthest(p_map, static_cast<std::size_t>(share * max_bytes));
-  }
-  return dropped;
-}
-
-void MapPyramid::begin_journal() {
-  for (auto& grid : grids_) grid.begin_journal();
-}
-
-void MapPyramid::rollback() {
-  for (auto& grid : grids_) grid.rollback();
-}
-
-void MapPyramid::end_journal() {
-  for (auto& grid : grids_) grid.end_journal();
-}
 
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
@@ -103,79 +49,6 @@ int distinct_cells(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>
 }
 
 }  // namespace
-
-Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
-                  const Pose2& T_center, double linear_window_m, double angular_window_rad) {
-  constexpr std::size_t kMaxPoints = 200;
-  constexpr int kMaxAngles = 181;
-  const double res = grid.resolution();
-  std::vector<Eigen::Vector2d> points;
-  const std::size_t stride = std::max<std::size_t>(1, points_base.size() / kMaxPoints);
-  double r_max = res;
-  for (std::size_t i = 0; i < points_base.size(); i += stride) {
-    points.push_back(points_base[i]);
-    r_max = std::max(r_max, points_base[i].norm());
-  }
-  const double angle_step = std::max(res / r_max, 2.0 * angular_window_rad / (kMaxAngles - 1));
-  const int n_angles = static_cast<int>(std::ceil(angular_window_rad / angle_step));
-  const int n_shift = static_cast<int>(std::ceil(linear_window_m / res));
-  // A dense copy of the grid around the centre: occupied evidence max(0, 2 (p - 0.5)), so that
-  // unknown space scores nothing and free space nothing either.
-  const int64_t cx = std::llround(T_center.x() / res), cy = std::llround(T_center.y() / res);
-  const int half = static_cast<int>(std::ceil(r_max / res)) + n_shift + 1;
-  const int side = 2 * half + 1;
-  std::vector<float> evidence(static_cast<std::size_t>(side) * side);
-  for (int j = 0; j < side; ++j) {
-    for (int i = 0; i < side; ++i) {
-      const double p = grid.cell_probability(cx - half + i, cy - half + j);
-      evidence[static_cast<std::size_t>(j) * side + i] =
-          static_cast<float>(std::max(0.0, 2.0 * (p - 0.5)));
-    }
-  }
-  // Every candidate's score; the winner is the candidate nearest the centre among those within
-  // kTolerance of the best score, so that a direction the scan cannot tell apart (a corridor's
-  // axis) keeps the centre's value instead of an arbitrary one.
-  constexpr double kTolerance = 0.03;
-  struct Candidate {
-    double score;
-    int a, dx, dy;
-  };
-  std::vector<Candidate> candidates;
-  std::vector<std::pair<int, int>> cells(points.size());
-  for (int a = -n_angles; a <= n_angles; ++a) {
-    const double theta = T_center.theta() + a * angle_step;
-    const Pose2 T(T_center.x(), T_center.y(), theta);
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const Eigen::Vector2d q = T * points[k];
-      cells[k] = {static_cast<int>(std::llround(q.x() / res) - cx) + half,
-                  static_cast<int>(std::llround(q.y() / res) - cy) + half};
-    }
-    for (int dy = -n_shift; dy <= n_shift; ++dy) {
-      for (int dx = -n_shift; dx <= n_shift; ++dx) {
-        double score = 0.0;
-        for (const auto& [i, j] : cells)
-          score += evidence[static_cast<std::size_t>(j + dy) * side + i + dx];
-        candidates.push_back({score, a, dx, dy});
-      }
-    }
-  }
-  double best_score = 0.0;
-  for (const auto& c : candidates) best_score = std::max(best_score, c.score);
-  const Candidate* best = nullptr;
-  double best_distance = std::numeric_limits<double>::infinity();
-  for (const auto& c : candidates) {
-    if (c.score < (1.0 - kTolerance) * best_score) continue;
-    const double distance = std::hypot(c.dx * res, c.dy * res) / linear_window_m +
-                            std::abs(c.a * angle_step) / angular_window_rad;
-    if (distance < best_distance) {
-      best_distance = distance;
-      best = &c;
-    }
-  }
-  if (!best) return T_center;
-  return Pose2(T_center.x() + best->dx * res, T_center.y() + best->dy * res,
-               T_center.theta() + best->a * angle_step);
-}
 
 namespace {
 
@@ -282,15 +155,6 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
   }
   result.iterations = iterations;
   return result;
-}
-
-StepPrior step_prior(const MatcherConfig& config, const Pose2& T_last) {
-  return {T_last,
-          config.sparse_step_min_travel_m,
-          config.sparse_step_min_turn_rad,
-          config.sparse_step_short_weight,
-          config.sparse_step_off_arc_free_m,
-          config.sparse_step_off_arc_weight};
 }
 
 MatchResult match_scan_wide(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,

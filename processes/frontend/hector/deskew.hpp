@@ -8,6 +8,8 @@
 #include <functional>
 #include <vector>
 
+#include "motion_model.hpp"
+
 namespace traverse::frontend {
 
 // heading_change(t) is the base's heading at t minus its heading at utime_ref [rad];
@@ -15,5 +17,10 @@ namespace traverse::frontend {
 void deskew_points(std::vector<Eigen::Vector2d>& points_base, const std::vector<int64_t>& utimes,
                    int64_t utime_ref, const std::function<double(int64_t)>& heading_change,
                    const Eigen::Vector2d& velocity_base, bool translation);
+
+// deskew_points() with the motion model's heading change (the IMU's when use_imu, else its
+// angular velocity) and velocity.
+void deskew_sweep(std::vector<Eigen::Vector2d>& points_base, const std::vector<int64_t>& utimes,
+                  int64_t utime_ref, const MotionModel& motion, bool use_imu, bool translation);
 
 }  // namespace traverse::frontend

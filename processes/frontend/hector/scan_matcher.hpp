@@ -11,7 +11,9 @@
 //
 // Recovery (not in the paper): when the residual after Gauss-Newton says the match failed, an
 // exhaustive search over a window of poses on the coarsest grid (scoring occupied evidence under
-// the points, as correlative matching does, Olson 2009) gives a new start for Gauss-Newton.
+// the points, as correlative matching does, Olson 2009: search_pose() in grid_search.hpp) gives a
+// new start for Gauss-Newton. Sparse scans start from the best pose of the wide search
+// (grid_search.hpp) instead of the prediction.
 //
 // Covariance: residuals 1 - M are unitless; with the map-value noise sigma^2 estimated from the
 // final residuals (sum r^2 / (n - 3), floored), the information of the pose is H / sigma^2 + P,
@@ -25,33 +27,10 @@
 #include <vector>
 
 #include "frontend_config.hpp"
-#include "occupancy_grid.hpp"
+#include "map_pyramid.hpp"
 #include "se2.hpp"
-#include "wide_search.hpp"
 
 namespace traverse::frontend {
-
-// Grids of resolution r, 2r, 4r, ... (level 0 is the finest), all updated with every scan.
-class MapPyramid {
- public:
-  explicit MapPyramid(const MapConfig& config);
-  int levels() const { return static_cast<int>(grids_.size()); }
-  const OccupancyGrid& level(int k) const { return grids_[k]; }
-  // Integrates a scan: hits in the base frame, seen from T_map_base * origin_base.
-  void update(const Pose2& T_map_base, const Eigen::Vector2d& origin_base,
-              const std::vector<Eigen::Vector2d>& hits_base);
-  std::size_t memory_bytes() const;
-  // Drops far tiles (all levels) so the total stays under max_bytes. Returns tiles dropped.
-  std::size_t bound_memory(const Eigen::Vector2d& p_map, std::size_t max_bytes);
-  // The journal of every level (OccupancyGrid::begin_journal): updates made while it is open
-  // can be undone exactly.
-  void begin_journal();
-  void rollback();
-  void end_journal();
-
- private:
-  std::vector<OccupancyGrid> grids_;
-};
 
 struct MatchResult {
   Pose2 T_map_base;
@@ -72,14 +51,6 @@ struct NormalEquations {
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
                                  const Pose2& T_map_base);
-
-// Best pose within +-linear_window_m (x, y) and +-angular_window_rad of T_center by exhaustive
-// search on `grid` (steps of one cell, and of the angle that moves the farthest point one cell).
-Pose2 search_pose(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>& points_base,
-                  const Pose2& T_center, double linear_window_m, double angular_window_rad);
-
-// The step prior of config's sparse_step_* keys for a step from T_last.
-StepPrior step_prior(const MatcherConfig& config, const Pose2& T_last);
 
 // Wide search around priors[0] (not empty) on pyramid level min(1, levels - 1) with a motion
 // prior towards the nearest of `priors`, then Gauss-Newton over all levels from the best pose,

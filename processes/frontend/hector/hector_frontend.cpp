@@ -1,0 +1,239 @@
+#include "hector_frontend.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "deskew.hpp"
+#include "grid_search.hpp"
+#include "scan_matcher.hpp"
+
+namespace traverse::frontend {
+namespace {
+
+// A sweep longer than this is not a sweep of a planar scanner: its times are wrong.
+constexpr int64_t kMaxSweepUs = 1'000'000;
+
+Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+// Gives `result` the pose of a match and its figures (iterations add up).
+void take_match(FrontendResult& result, const MatchResult& m) {
+  result.T_map_base = m.T_map_base;
+  result.covariance = m.covariance;
+  FrontendDiagnostics& d = *result.diagnostics;
+  d.matched_points = m.points;
+  d.iterations += m.iterations;
+  d.residual_rms = m.residual_rms;
+  d.searched = d.searched || m.searched;
+}
+
+}  // namespace
+
+HectorFrontend::HectorFrontend(const FrontendConfig& config)
+    : config_(config),
+      T_initial_(config.initial_pose.pose()),
+      scan_points_(config.T_base_laser.pose(), config.matcher.min_range_m,
+                   config.matcher.max_range_m),
+      motion_(T_initial_, rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
+                                       config.deskew.imu_yaw_rad)),
+      map_(config.map) {}
+
+bool HectorFrontend::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) {
+  const bool taken = motion_.add_imu(utime, angular_velocity_imu);
+  ++(taken ? counters_.imu_samples : counters_.imu_dropped);
+  return taken;
+}
+
+bool HectorFrontend::add_odometry(const OdometrySample& odometry) {
+  const bool taken = motion_.add_odometry(odometry);
+  ++(taken ? counters_.odometry_samples : counters_.odometry_dropped);
+  return taken;
+}
+
+Measurement HectorFrontend::measure(const Scan& scan) {
+  ++counters_.scans_received;
+  Measurement m;
+  FrontendResult& r = m.result;
+  r.utime = scan.utime_last;
+  FrontendDiagnostics& d = r.diagnostics.emplace();
+  const bool initialised = motion_.initialised();
+  // Times first: a sweep ending before it starts, or not after the last pose, is dropped.
+  if (scan.utime_last < scan.utime_first || scan.utime_last - scan.utime_first > kMaxSweepUs ||
+      (initialised && scan.utime_last <= motion_.last_utime())) {
+    ++counters_.scans_dropped_time;
+    return m;
+  }
+  ScanPoints points = scan_points_(scan);
+  counters_.readings_invalid += points.invalid;
+  d.valid_points = static_cast<int>(points.points_base.size());
+  // The IMU must reach back to the last pose (or, for the first scan, to its first point).
+  const bool use_imu =
+      motion_.imu_covers(initialised ? motion_.last_utime() : scan.utime_first, scan.utime_last);
+  d.imu_used = use_imu;
+  // Sparse: this scan comes long after the last, or the stream's recent scans did (a log
+  // subsampled by travel, whose timestamps also hold repeats and near repeats that say nothing
+  // about the motion in between: intel has 23 of 910 scans under 0.5 s apart, some 0 s).
+  m.subsampled_by_travel =
+      initialised && motion_.subsampled_by_travel(config_.matcher.wide_search_gap_us);
+  r.sparse =
+      initialised && (scan.utime_last - motion_.last_utime() > config_.matcher.wide_search_gap_us ||
+                      m.subsampled_by_travel);
+
+  if (d.valid_points < config_.matcher.min_valid_points) {
+    ++counters_.scans_predicted;
+    if (initialised) {
+      take_prediction(m, motion_.extrapolate(scan.utime_last, use_imu, r.sparse));
+    } else {  // nothing to predict from yet: where the trajectory starts
+      r.T_map_base = T_initial_;
+      d.T_map_base_predicted = T_initial_;
+      r.status = ScanStatus::kPredicted;
+    }
+    return m;
+  }
+
+  const auto deskew = [&] {
+    if (config_.deskew.enabled) {
+      deskew_sweep(points.points_base, points.utimes, scan.utime_last, motion_, use_imu,
+                   config_.deskew.translation);
+    }
+  };
+  r.status = ScanStatus::kMatched;
+  if (!initialised) {
+    // The first scan's pose is given (initial_pose, the identity by default): exact by definition.
+    deskew();
+    r.T_map_base = T_initial_;
+    d.T_map_base_predicted = T_initial_;
+    r.covariance = Eigen::Matrix3d::Identity() * 1e-12;
+    d.matched_points = d.valid_points;
+  } else {
+    const Pose2 T_pred = motion_.extrapolate(scan.utime_last, use_imu, r.sparse);
+    d.T_map_base_predicted = T_pred;
+    deskew();
+    // Should the prediction fail, the recovery also searches around the last pose (no motion).
+    const Pose2& T_last = motion_.last_pose();
+    std::vector<Pose2> other_centres;
+    if (between(T_pred, T_last).translation().norm() > config_.map.resolution_m ||
+        std::abs(between(T_pred, T_last).theta()) > 0.01) {
+      other_centres.push_back(T_last);
+    }
+    // The step prior holds for a log subsampled by travel, not for a pause in a scanner's stream
+    // (freiburg-079: 40 gaps over 0.5 s, the robot standing still).
+    m.points_matched = subsample(points.points_base, config_.matcher.min_point_spacing_m);
+    const MatchResult match =
+        r.sparse
+            ? match_scan_wide(map_, m.points_matched, {T_pred}, config_.matcher,
+                              m.subsampled_by_travel ? &T_last : nullptr)
+            : match_scan(map_, m.points_matched, T_pred, config_.matcher, -1, 0, other_centres);
+    if (match.searched) ++counters_.scans_searched;
+    // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
+    // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes
+    // from a scan that fits nowhere (people round the scanner, a view the map has not seen).
+    // Sparse scans are predicted too poorly for this (their steps of a metre are what the wide
+    // search is for).
+    if (!r.sparse && unverified(match, T_pred, config_.matcher)) {
+      ++counters_.scans_unverified;
+      take_prediction(m, T_pred);
+      d.residual_rms = match.residual_rms;
+      d.searched = match.searched;
+      return m;
+    }
+    take_match(r, match);
+  }
+  ++counters_.scans_matched;
+  m.points = std::move(points.points_base);
+  return m;
+}
+
+void HectorFrontend::take_prediction(Measurement& m, const Pose2& T_predicted) const {
+  FrontendResult& r = m.result;
+  r.status = ScanStatus::kPredicted;
+  r.T_map_base = T_predicted;
+  r.diagnostics->T_map_base_predicted = T_predicted;
+  const double sxy = config_.matcher.prior_sigma_xy_m;
+  const double sth = config_.matcher.prior_sigma_theta_rad;
+  const Eigen::Vector3d prior(std::pow(sxy, 2), std::pow(sxy, 2), std::pow(sth, 2));
+  r.covariance = motion_.last_covariance() + Eigen::Matrix3d(prior.asDiagonal());
+}
+
+void HectorFrontend::integrate(Measurement& m) {
+  FrontendResult& r = m.result;
+  if (r.status == ScanStatus::kPredicted) {
+    // A blind first scan leaves the motion model where the trajectory starts.
+    if (motion_.initialised())
+      motion_.add_prediction(r.utime, r.T_map_base, r.covariance, r.sparse);
+    return;
+  }
+  if (r.status != ScanStatus::kMatched) return;
+  motion_.add_pose(r.utime, r.T_map_base, r.covariance, r.sparse);
+  r.diagnostics->map_updated = false;
+  if (T_map_base_last_update_ && !map_update_due(r.T_map_base)) return;
+  map_.update(r.T_map_base, config_.T_base_laser.pose().translation(), m.points);
+  T_map_base_last_update_ = r.T_map_base;
+  counters_.map_tiles_evicted += static_cast<int64_t>(map_.bound_memory(
+      r.T_map_base.translation(), static_cast<std::size_t>(config_.map.max_bytes)));
+  ++counters_.map_updates;
+  r.diagnostics->map_updated = true;
+}
+
+bool HectorFrontend::map_update_due(const Pose2& T_map_base) const {
+  const Pose2 d = between(*T_map_base_last_update_, T_map_base);
+  return d.translation().norm() >= config_.map.update_distance_m ||
+         std::abs(d.theta()) >= config_.map.update_angle_rad;
+}
+
+Measurement HectorFrontend::rematch(const Measurement& measurement, const SearchArea& area) const {
+  MatcherConfig config = config_.matcher;
+  config.wide_search_linear_window_m = area.linear_window_m;
+  config.wide_search_angular_window_rad = area.angular_window_rad;
+  Measurement m = measurement;
+  take_match(m.result,
+             match_scan_wide(map_, m.points_matched, {area.T_centre}, config, &area.T_from));
+  return m;
+}
+
+double HectorFrontend::evidence(const Measurement& m, const Pose2& T_map_base) const {
+  // The wide search's level, scored as the wide search scores a pose.
+  return pose_evidence(map_.level(std::min(1, map_.levels() - 1)), m.points_matched, T_map_base);
+}
+
+void HectorFrontend::begin_tentative() {
+  map_.begin_journal();
+  before_tentative_ = Integrated{motion_.state(), T_map_base_last_update_, counters_.map_updates};
+}
+
+void HectorFrontend::rollback() {
+  map_.rollback();
+  motion_.restore(before_tentative_->motion);
+  T_map_base_last_update_ = before_tentative_->T_map_base_last_update;
+  counters_.map_updates = before_tentative_->map_updates;
+  before_tentative_.reset();
+}
+
+void HectorFrontend::commit() {
+  map_.end_journal();
+  before_tentative_.reset();
+}
+
+void HectorFrontend::report(const CounterSink& sink) const {
+  const Counters& c = counters_;
+  sink("scans_received", static_cast<double>(c.scans_received));
+  sink("scans_matched", static_cast<double>(c.scans_matched));
+  sink("scans_predicted", static_cast<double>(c.scans_predicted));
+  sink("scans_unverified", static_cast<double>(c.scans_unverified));
+  sink("scans_searched", static_cast<double>(c.scans_searched));
+  sink("scans_dropped_time", static_cast<double>(c.scans_dropped_time));
+  sink("readings_invalid", static_cast<double>(c.readings_invalid));
+  sink("map_updates", static_cast<double>(c.map_updates));
+  sink("map_tiles_evicted", static_cast<double>(c.map_tiles_evicted));
+  sink("imu_samples", static_cast<double>(c.imu_samples));
+  sink("imu_dropped", static_cast<double>(c.imu_dropped));
+  sink("odometry_samples", static_cast<double>(c.odometry_samples));
+  sink("odometry_dropped", static_cast<double>(c.odometry_dropped));
+}
+
+}  // namespace traverse::frontend

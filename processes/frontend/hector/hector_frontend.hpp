@@ -1,0 +1,90 @@
+// The Hector frontend (seed 000 section 2, Hector SLAM section IV), a two-phase frontend
+// (two_phase.hpp). Measuring a scan:
+//   1. keep the valid readings (finite, inside the scanner's and the config's range; too few:
+//      the pose is predicted, flagged);
+//   2. predict the pose at the scan's last point (motion_model.hpp: IMU, odometry, the velocity
+//      of the last poses, or the average step of a sparse log);
+//   3. undo the motion during the sweep (deskew.hpp);
+//   4. match the points against the map pyramid, coarse to fine, from the prediction
+//      (scan_matcher.hpp); sparse scans, those more than matcher.wide_search_gap_us after the
+//      last pose or of a stream whose recent scans were (a log subsampled by travel), from the
+//      best pose of a wide correlative search around it (grid_search.hpp), which on a log
+//      subsampled by travel also weighs the step's shape (step_prior.hpp);
+//   5. a match on a scanner's stream that lands far from the prediction with a poor fit is not
+//      trusted: the pose is the prediction, flagged, and the scan stays out of the map.
+// Integrating it: the pose goes into the motion model, and the scan into the map when the pose
+// moved or turned past a threshold since the last update. A scan whose time does not advance, or
+// whose last point is before its first, is dropped. Each case is counted.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+
+#include "frontend_config.hpp"
+#include "map_pyramid.hpp"
+#include "motion_model.hpp"
+#include "scan_points.hpp"
+#include "two_phase.hpp"
+
+namespace traverse::frontend {
+
+class HectorFrontend final : public TwoPhaseFrontend {
+ public:
+  // The config must pass validate(); the trajectory starts at config.initial_pose.
+  explicit HectorFrontend(const FrontendConfig& config);
+
+  bool add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) override;
+  bool add_odometry(const OdometrySample& odometry) override;
+  Measurement measure(const Scan& scan) override;
+  void integrate(Measurement& measurement) override;
+  Measurement rematch(const Measurement& measurement, const SearchArea& area) const override;
+  double evidence(const Measurement& measurement, const Pose2& T_map_base) const override;
+  Pose2 last_pose() const override { return motion_.last_pose(); }
+  void begin_tentative() override;
+  void rollback() override;
+  void commit() override;
+  std::size_t map_bytes() const override { return map_.memory_bytes(); }
+  void report(const CounterSink& sink) const override;
+
+  const MapPyramid& map() const { return map_; }
+
+ private:
+  struct Counters {
+    int64_t scans_received = 0;
+    int64_t scans_matched = 0;
+    int64_t scans_predicted = 0;     // too few valid points
+    int64_t scans_unverified = 0;    // match far from the prediction with a poor fit: predicted
+    int64_t scans_searched = 0;      // matches that needed a correlative search
+    int64_t scans_dropped_time = 0;  // time going backwards or utime_last < utime_first
+    int64_t readings_invalid = 0;    // NaN, zero or out-of-range readings ignored
+    int64_t map_updates = 0;
+    int64_t map_tiles_evicted = 0;
+    int64_t imu_samples = 0;
+    int64_t imu_dropped = 0;  // IMU samples not after the previous one, or not finite
+    int64_t odometry_samples = 0;
+    int64_t odometry_dropped = 0;
+  };
+  // What an integration changes besides the map's cells: undone with them.
+  struct Integrated {
+    MotionModel::State motion;
+    std::optional<Pose2> T_map_base_last_update;  // the pose of the map's last update
+    int64_t map_updates = 0;
+  };
+
+  // The measurement's pose predicted (status kPredicted), its covariance the last one's grown by
+  // the motion prior's.
+  void take_prediction(Measurement& m, const Pose2& T_predicted) const;
+  bool map_update_due(const Pose2& T_map_base) const;
+
+  FrontendConfig config_;
+  Pose2 T_initial_;
+  ScanPointMaker scan_points_;
+  MotionModel motion_;
+  MapPyramid map_;
+  std::optional<Pose2> T_map_base_last_update_;
+  std::optional<Integrated> before_tentative_;
+  Counters counters_;
+};
+
+}  // namespace traverse::frontend

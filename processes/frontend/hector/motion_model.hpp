@@ -1,0 +1,93 @@
+// The motion of the base between scans, as cartographer's pose extrapolator: the poses the
+// matcher measured go in (add_pose), and so do IMU yaw rates and wheel odometry; the pose at a
+// later time comes out (extrapolate), and the heading change and velocity within a sweep for
+// de-skewing it (deskew.hpp).
+//   - Heading change: the IMU's yaw rate integrated (yaw_integrator.hpp) when its samples cover
+//     the time since the last pose, else the angular velocity of the last poses.
+//   - Translation: wheel odometry's relative motion when its samples cover the time since the
+//     last pose, else the velocity of the last poses over the elapsed time, over at most twice
+//     the last interval (after a pause it would predict an arbitrarily long step). The velocity
+//     is differenced from consecutive poses and averaged exponentially over about 0.1 s (poses a
+//     few milliseconds apart are noisy to difference).
+//   - Sparse scans (far apart in time, see MatcherConfig::wide_search_gap_us) of a log
+//     subsampled by travel (the CARMEN sets) without IMU or odometry: their times say little
+//     about the motion, so the prediction is the average of the last sparse steps. Such a log
+//     moves about the same distance per scan, so the average keeps predicting forward motion
+//     where one step was underestimated (a corridor that does not show motion along its axis):
+//     repeating the last step would repeat the stall.
+// Everything derived from the poses is one State, which a frontend that takes a pose back (an
+// integration undone, two_phase.hpp) restores; the IMU and odometry samples are inputs, kept.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <optional>
+
+#include "frontend.hpp"
+#include "recent_values.hpp"
+#include "se2.hpp"
+#include "yaw_integrator.hpp"
+
+namespace traverse::frontend {
+
+class MotionModel {
+ public:
+  // Before the first pose the last pose is T_map_base_initial (where the trajectory starts).
+  MotionModel(const Pose2& T_map_base_initial, const Eigen::Matrix3d& R_base_imu);
+
+  // Samples not after the previous one, or not finite, are refused (false).
+  bool add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu);
+  bool add_odometry(const OdometrySample& odometry);
+
+  // A measured pose at `utime` with its covariance; `sparse`: a sparse scan's (the average step
+  // of sparse scans follows it).
+  void add_pose(int64_t utime, const Pose2& T_map_base, const Eigen::Matrix3d& covariance,
+                bool sparse);
+  // A predicted pose (nothing was measured): as add_pose, but the velocity stays as it was.
+  void add_prediction(int64_t utime, const Pose2& T_map_base, const Eigen::Matrix3d& covariance,
+                      bool sparse);
+
+  bool initialised() const { return state_.initialised; }  // a pose was added
+  const Pose2& last_pose() const { return state_.T_map_base_last; }
+  int64_t last_utime() const { return state_.last_utime; }
+  const Eigen::Matrix3d& last_covariance() const { return state_.covariance_last; }
+  // (vx [m/s], vy [m/s], omega [rad/s]) in the base frame, from the last poses.
+  const Eigen::Vector3d& velocity() const { return state_.velocity; }
+
+  // IMU samples reach back to `from` and are recent at `to` (not older than 0.5 s).
+  bool imu_covers(int64_t from, int64_t to) const;
+  // Heading change of the base from t0 to t1 [rad] by the IMU (imu_covers() must hold).
+  double imu_heading_change(int64_t t0, int64_t t1) const { return yaw_.heading_change(t0, t1); }
+  // The median of the last five intervals between poses exceeds gap_us: scans come further apart
+  // than any scanner's period, a log subsampled by travel.
+  bool subsampled_by_travel(int64_t gap_us) const;
+
+  // The pose at `utime` (after the last pose), see the header. use_imu: imu_covers() from the
+  // last pose to utime; sparse: the scan is a sparse one.
+  Pose2 extrapolate(int64_t utime, bool use_imu, bool sparse) const;
+
+  struct State {
+    bool initialised = false;
+    int64_t last_utime = 0;        // [us] of the last pose
+    int64_t last_interval_us = 0;  // [us] between the last two poses
+    Pose2 T_map_base_last;
+    Eigen::Matrix3d covariance_last = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    // Average step per sparse scan (log of the relative pose, base frame).
+    std::optional<Eigen::Vector3d> sparse_step;
+    RecentValues<5> recent_intervals_us;  // between the last poses [us]
+  };
+  const State& state() const { return state_; }
+  void restore(const State& state) { state_ = state; }
+
+ private:
+  // The relative motion by wheel odometry from t0 to t1, if its samples cover both times.
+  std::optional<Pose2> odometry_motion(int64_t t0, int64_t t1) const;
+
+  YawIntegrator yaw_;
+  std::deque<OdometrySample> odometry_;
+  State state_;
+};
+
+}  // namespace traverse::frontend
