@@ -35,3 +35,37 @@ add_dependencies(traverse_lcmtypes lcmtypes_gen)
 target_include_directories(traverse_lcmtypes SYSTEM PUBLIC ${LCM_OUT})
 target_include_directories(traverse_lcmtypes PRIVATE ${CMAKE_SOURCE_DIR}/common)
 target_link_libraries(traverse_lcmtypes PUBLIC lcm::lcm)
+
+# The same types for Python (build/python/traverse/, for analysis scripts: LCM 1.3.1 in Debian has
+# no Python module, scripts/lcmlog.py reads logs) and Java (build/java/traverse-lcmtypes.jar, for
+# lcm-spy: scripts/spy.sh), so that every tool decodes every channel.
+# lcm_gen_language(LANG PATH_FLAG DIR EXT OUT_VAR): lcm-gen --LANG into DIR/traverse/*.EXT;
+# the generated files' list in OUT_VAR.
+function(lcm_gen_language lang path_flag dir ext out_var)
+  set(files "")
+  foreach(f ${LCM_FILES})
+    get_filename_component(type ${f} NAME_WE)
+    list(APPEND files ${dir}/traverse/${type}.${ext})
+  endforeach()
+  add_custom_command(
+    OUTPUT ${files}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${dir}
+    COMMAND ${LCM_GEN} --${lang} ${path_flag} ${dir} ${LCM_FILES}
+    DEPENDS ${LCM_FILES}
+    COMMENT "lcm-gen: generating ${lang} message types")
+  set(${out_var} ${files} PARENT_SCOPE)
+endfunction()
+
+lcm_gen_language(python --ppath ${CMAKE_BINARY_DIR}/python py LCM_PY_FILES)
+add_custom_target(lcmtypes_python ALL DEPENDS ${LCM_PY_FILES})
+
+find_package(Java COMPONENTS Development)
+find_file(LCM_JAR lcm.jar PATHS /usr/share/java /usr/local/share/java)
+if(Java_FOUND AND LCM_JAR)
+  include(UseJava)
+  lcm_gen_language(java --jpath ${CMAKE_BINARY_DIR}/java/src java LCM_JAVA_FILES)
+  add_jar(traverse_lcmtypes_java SOURCES ${LCM_JAVA_FILES} INCLUDE_JARS ${LCM_JAR}
+    OUTPUT_NAME traverse-lcmtypes OUTPUT_DIR ${CMAKE_BINARY_DIR}/java)
+else()
+  message(STATUS "No Java compiler or lcm.jar (liblcm-java): no Java message types, no lcm-spy")
+endif()

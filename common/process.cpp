@@ -14,6 +14,7 @@
 #include "channels.hpp"
 #include "lcm_log.hpp"
 #include "traverse/process_status_t.hpp"
+#include "version.hpp"
 
 namespace traverse {
 namespace {
@@ -93,6 +94,7 @@ Process::Process(std::string name, std::string description)
                       kDefaultLcmUrl + ")");
   app_.add_option("--name", name_, "instance name; status goes to STATUS_<NAME>")
       ->capture_default_str();
+  add_version_flag(app_);
 }
 
 void Process::offer_replay() {

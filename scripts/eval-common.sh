@@ -8,6 +8,9 @@ GRAPH_JSON=""  # run-graph's JSON line, merged into the output under "graph"
 # Programs come from build/bin (scripts/setup.sh builds it when it is missing); TRAVERSE_BIN_DIR
 # points elsewhere, e.g. at another build tree.
 BIN="${TRAVERSE_BIN_DIR:-$ROOT/build/bin}"
+# Debian's interpreter first: the one python3-yaml (scripts/conf.py) installs into.
+PYTHON=/usr/bin/python3
+[[ -x $PYTHON ]] || PYTHON=python3
 
 die() {
   echo "$(basename "$0"): $*" >&2
@@ -105,15 +108,13 @@ run_graph() {
   [[ -x $ROOT/scripts/run-graph.sh ]] || die "scripts/run-graph.sh not found"
   local rc=0 deploy="$ROOT/configs/deploy/pipeline.yaml"
   if [[ -n ${DESKEW_OFF:-} ]]; then
-    awk '/^[^ #]/ { in_deskew = ($1 == "deskew:") }
-         in_deskew && $1 == "enabled:" { sub(/true/, "false") } { print }' \
-      "$ROOT/configs/frontend.yaml" >"$out/frontend-deskew-off.yaml"
-    grep -q '^  enabled: false' "$out/frontend-deskew-off.yaml" ||
-      die "configs/frontend.yaml has no 'deskew: enabled: true' to switch off"
-    sed "s#^\(    config: \)configs/frontend.yaml#\1$out/frontend-deskew-off.yaml#" "$deploy" \
-      >"$out/pipeline-deskew-off.yaml"
-    grep -q "frontend-deskew-off.yaml" "$out/pipeline-deskew-off.yaml" ||
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$ROOT/configs/frontend.yaml" deskew.enabled false \
+      >"$out/frontend-deskew-off.yaml" ||
+      die "configs/frontend.yaml has no deskew.enabled to switch off"
+    [[ $("$PYTHON" "$ROOT/scripts/conf.py" get "$deploy" processes.frontend.config) == configs/frontend.yaml ]] ||
       die "configs/deploy/pipeline.yaml does not run the frontend with configs/frontend.yaml"
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$deploy" processes.frontend.config \
+      "$out/frontend-deskew-off.yaml" >"$out/pipeline-deskew-off.yaml"
     deploy="$out/pipeline-deskew-off.yaml"
   fi
   TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$deploy" \
@@ -212,14 +213,8 @@ cloud_evaluate() {
 # evaluation's fields (when the mapper ran) after it, and the graph's JSON (when run-graph printed
 # one) under "graph".
 merged_json() {
-  local head="$1" body="${EVAL_JSON#\{}"
-  if [[ -n ${CLOUD_JSON:-} ]]; then
-    body="${body%\}}, ${CLOUD_JSON#\{}"
-  fi
-  if [[ -n ${GRAPH_JSON:-} ]]; then
-    body="${body%\}}, \"graph\": $GRAPH_JSON}"
-  fi
-  echo "{$head, $body"
+  "$PYTHON" "$ROOT/scripts/conf.py" merge "{$1}" "$EVAL_JSON" "${CLOUD_JSON:-}" \
+    ${GRAPH_JSON:+graph="$GRAPH_JSON"}
 }
 
 # A JSON string literal (quotes and backslashes escaped).

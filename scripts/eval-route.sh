@@ -59,8 +59,8 @@ done
 route_file="$ROOT/configs/routes/$route.yaml"
 [[ -f $route_file ]] || die "no route $route_file (routes: $(cd "$ROOT/configs/routes" && ls *.yaml | sed 's/\.yaml$//' | tr '\n' ' '))"
 # The route names its world: "world: office" (configs/worlds/office.yaml) or a path.
-world="$(sed -n 's/^world:[[:space:]]*\([^#[:space:]]*\).*/\1/p' "$route_file" | head -n 1)"
-[[ -n $world ]] || die "$route_file has no 'world:' key"
+world="$("$PYTHON" "$ROOT/scripts/conf.py" get "$route_file" world 2>/dev/null)" ||
+  die "$route_file has no 'world:' key"
 case "$world" in
   */* | *.yaml) world_file="$ROOT/$world" ;;
   *) world_file="$ROOT/configs/worlds/$world.yaml" ;;

@@ -43,13 +43,10 @@ done
 need_programs traverse-frontend traverse-evaluator
 # The log converted (cached) by scripts/eval-carmen.sh, whose JSON names it and the log's name.
 converted="$("$ROOT/scripts/eval-carmen.sh" "$what" | tail -n 1)"
-name="$(sed -n 's/.*"carmen": "\([^"]*\)".*/\1/p' <<<"$converted")"
-cache="$(sed -n 's/.*"lcm_log": "\([^"]*\)".*/\1/p' <<<"$converted")"
+name="$("$PYTHON" "$ROOT/scripts/conf.py" get - carmen <<<"$converted")" || name=""
+cache="$("$PYTHON" "$ROOT/scripts/conf.py" get - lcm_log <<<"$converted")" || cache=""
 [[ -n $name && -s $cache ]] || die "scripts/eval-carmen.sh $what named no converted log"
-grep -q '^initial_pose: ' "$ROOT/configs/frontend.yaml" ||
-  die "configs/frontend.yaml has no top-level 'initial_pose:' line to replace"
-grep -q '^  sparse_ensemble_members: ' "$ROOT/configs/frontend.yaml" ||
-  die "configs/frontend.yaml has no 'matcher: sparse_ensemble_members:' line to replace"
+conf() { "$PYTHON" "$ROOT/scripts/conf.py" "$@"; }
 
 out="$ROOT/out/sensitivity/carmen-$name${members:+-members$members}"
 rm -rf "$out"
@@ -65,19 +62,20 @@ for ((i = 0; i < starts; i++)); do
            (i == 0 ? 0 : (2 * (h - int(h)) - 1) * 3.14159265358979 / 180) }')
   dir="$out/start-$i"
   mkdir -p "$dir"
-  sed -e "s|^initial_pose: .*|initial_pose: {x_m: $x, y_m: $y, theta_rad: $theta}|" \
-    -e "${members:+s|^  sparse_ensemble_members: .*|  sparse_ensemble_members: $members|}" \
-    "$ROOT/configs/frontend.yaml" >"$dir/frontend.yaml"
+  conf set "$ROOT/configs/frontend.yaml" initial_pose "{x_m: $x, y_m: $y, theta_rad: $theta}" \
+    >"$dir/frontend.yaml"
+  if [[ -n $members ]]; then
+    conf set "$dir/frontend.yaml" matcher.sparse_ensemble_members "$members" >"$dir/frontend.tmp"
+    mv "$dir/frontend.tmp" "$dir/frontend.yaml"
+  fi
   "$BIN/traverse-frontend" --config "$dir/frontend.yaml" --replay "$cache" \
     --record "$dir/run.lcmlog" >"$dir/frontend.out" 2>&1 ||
     die "traverse-frontend failed on start $i, see $dir/frontend.out"
   evaluate "$dir/run.lcmlog" POSE_FRONTEND POSE_REFERENCE "$dir"
   rm -f "$dir/run.lcmlog"
-  read -r jump rpe1 rpe10 < <(echo "$EVAL_JSON" | awk '{
-    for (k = 1; k <= NF; k++) v[$k] = $(k + 1)
-    gsub(/[,}]/, "", v["\"max_jump_m\":"]); gsub(/[,}]/, "", v["\"rpe_1m_m\":"]);
-    gsub(/[,}]/, "", v["\"rpe_10m_m\":"])
-    print v["\"max_jump_m\":"], v["\"rpe_1m_m\":"], v["\"rpe_10m_m\":"] }')
+  jump="$(conf get - max_jump_m <<<"$EVAL_JSON")"
+  rpe1="$(conf get - rpe_1m_m <<<"$EVAL_JSON")"
+  rpe10="$(conf get - rpe_10m_m <<<"$EVAL_JSON")"
   [[ $jump =~ ^[0-9.]+$ ]] || die "no max_jump_m in the evaluator's JSON of start $i"
   printf 'start %2d: x %.4f m, y %.4f m, theta %+.6f rad: largest jump %.3f m, rpe over 1 m %.3f m, over 10 m %.3f m\n' \
     "$i" "$x" "$y" "$theta" "$jump" "$rpe1" "$rpe10" >&2
@@ -90,6 +88,7 @@ read -r median worst over < <(printf '%s\n' "${jumps[@]}" | sort -g | awk '
   { v[NR] = $1; if ($1 > 0.5) n++ }
   END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%.6f %.6f %d\n", m, v[NR], n }')
 rpe10_worst="$(printf '%s\n' "${rpe10s[@]}" | sort -g | tail -n 1)"
-members_used="$(awk '$1 == "sparse_ensemble_members:" { print $2 }' "$out/start-0/frontend.yaml")"
+members_used="$(conf get "$out/start-0/frontend.yaml" matcher.sparse_ensemble_members 2>/dev/null)" ||
+  members_used="null"  # the frontend's default (frontend_config.hpp)
 echo "frontend-sensitivity: $name, $starts starts, $members_used-member ensemble: largest jump median $median m, worst $worst m, $over starts over 0.5 m; rpe over 10 m worst $rpe10_worst m; outputs in $out" >&2
 echo "{\"carmen\": $(json_str "$name"), \"starts\": $starts, \"sparse_ensemble_members\": $members_used, \"max_jump_median_m\": $median, \"max_jump_worst_m\": $worst, \"starts_over_0_5_m\": $over, \"rpe_10m_worst_m\": $rpe10_worst, \"runs\": [$runs], \"out_dir\": $(json_str "$out")}"

@@ -191,7 +191,7 @@ void BackendNode::publish(const BackendUpdate& update) {
   for (int i : update.new_key_poses) {
     pose2d_t pose{};
     pose.utime = keys[i].utime;
-    pose.parent_frame = "world";
+    pose.parent_frame = "map";  // the frontend's frame, which the graph keeps
     pose.child_frame = "base";
     pose.x = keys[i].T_world_base.x();
     pose.y = keys[i].T_world_base.y();

@@ -15,6 +15,7 @@
 #include "rig.hpp"
 #include "rng.hpp"
 #include "trajectory.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   app.add_option("routes", routes, "route YAML files (configs/routes/*.yaml)")->required();
   app.add_option("--seed", seed);
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   std::ostringstream out;

@@ -54,7 +54,7 @@ struct DensifierConfig {
   double turn_lever_m = 0.5;                   // [m/rad] a turn of 1 rad counts as this much travel
   double republish_threshold_m = 1e-4;         // [m] a segment moving less is not sent again
   double republish_threshold_rad = 1e-5;       // [rad] same for headings
-  std::string parent_frame = "world";          // frame of the published poses
+  std::string parent_frame = "map";  // frame of the published poses: the frontend's
   std::string key_pose_channel = "KEY_POSES";  // key_poses_t from the backend
   // [bytes] largest encoded dense_segments_t: under 64 KB, one UDP datagram's worth.
   int max_message_bytes = 60000;

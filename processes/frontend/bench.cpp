@@ -23,6 +23,7 @@
 #include "traverse/imu_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
+#include "version.hpp"
 
 namespace fe = traverse::frontend;
 
@@ -159,6 +160,7 @@ int main(int argc, char** argv) {
                  "LCM log with SCAN_HORIZONTAL and IMU (e.g. from traverse-sim)");
   app.add_option("--scans", scans, "synthetic sweeps when no --log")->capture_default_str();
   app.add_option("--config", config_path, "frontend config (YAML); defaults otherwise");
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
   fe::FrontendConfig config;
   try {

@@ -20,6 +20,7 @@
 #include "control.hpp"
 #include "deployment.hpp"
 #include "run_modes.hpp"
+#include "version.hpp"
 
 namespace fs = std::filesystem;
 using traverse::launch::Options;
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
       "traverse-launch");
   Options o;
   add_options(app, o);
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   if (!o.control.empty()) {

@@ -9,6 +9,7 @@
 #include "config.hpp"
 #include "mapper.hpp"
 #include "simulator.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration_s, "[s] of profiles");
   app.add_option("--begin", begin_s, "[s] into the route");
   app.add_option("--baseline", baseline_s, "[s] of profiles given to insertPointCloud");
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   ts::WorldSpec world;

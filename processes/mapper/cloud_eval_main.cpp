@@ -13,6 +13,7 @@
 #include "lcm_log.hpp"
 #include "ply.hpp"
 #include "traverse/pose2d_t.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
   app.add_option("--reference", reference, "true trajectory channel");
   app.add_option("--max-points", max_points,
                  "surface distances on at most this many points (evenly spread)");
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   traverse::sim::WorldSpec spec;

@@ -33,9 +33,10 @@ bool write_ply(const std::string& path, int64_t count,
   std::ofstream f(path, std::ios::binary);
   if (!f) return false;
   f << "ply\nformat binary_little_endian 1.0\n"
-    << "comment Traverse cloud: x y z [m] in frame world, intensity [0..255], time [s] since "
-       "the Unix epoch, key_id = key pose whose segment placed the point, red green blue level = "
-       "accuracy colour and level of the annotations (-1: none)\n"
+    << "comment Traverse cloud: x y z [m] in frame map (the base at the first scan, or the "
+       "frontend's initial_pose), intensity [0..255], time [s] since the Unix epoch, key_id = "
+       "key pose whose segment placed the point, red green blue level = accuracy colour and "
+       "level of the annotations (-1: none)\n"
     << "element vertex " << count << "\n"
     << kProperties << "end_header\n";
   std::vector<char> buf;

@@ -1,4 +1,5 @@
-// Binary PLY (little endian) for the mapper's cloud: x, y, z [m, float32] in the world frame,
+// Binary PLY (little endian) for the mapper's cloud: x, y, z [m, float32] in the map frame (the
+// base at the first scan, or the frontend's initial_pose; traverse-export writes other frames),
 // intensity [0..255, uchar], time [s since the Unix epoch, float64], key_id [int32, the key pose
 // whose segment placed the point], red, green, blue [0..255, uchar] and level [char, the accuracy
 // level index of the annotations, -1 for none] (point_colours.hpp). Opens in CloudCompare and

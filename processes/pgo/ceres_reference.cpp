@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "graph_io.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -78,6 +79,7 @@ int main(int argc, char** argv) {
                  "function tolerance (relative cost decrease); gradient and parameter "
                  "tolerances are set 100 times tighter")
       ->capture_default_str();
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   auto read = traverse::backend::read_pose_graph(file);

@@ -11,6 +11,7 @@
 #include "config.hpp"
 #include "graph_io.hpp"
 #include "spa.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
                  "write per-pose marginal covariances (world frame, x y theta) as CSV");
   app.add_flag("--no-marginals", skip_marginals, "skip the covariance recovery");
   app.add_option("--config", config_path, "YAML optimiser settings (see configs/pgo.yaml)");
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   traverse::backend::SpaConfig config;

@@ -15,6 +15,7 @@
 #include "config.hpp"
 #include "realism.hpp"
 #include "simulator.hpp"
+#include "version.hpp"
 
 namespace {
 
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-range", rc.max_range_m, "[m] beams beyond are left out, both sides")
       ->capture_default_str();
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   std::map<int, Group> groups;

@@ -26,7 +26,8 @@ struct MonitorConfig {
   int64_t max_out_of_order = 0;   // [messages] a process dropped as stamped before the last one
   int64_t max_queue_dropped = 0;  // [messages] a process's receive queue dropped
   int64_t max_rejected = 0;       // [messages] a process rejected or dropped as stamp outliers
-  int64_t max_seq_gaps = 0;       // [messages] the monitor itself missed on a channel
+  int64_t max_seq_gaps = 0;       // [messages] the monitor itself missed on a channel: above
+                                  // it a note (its own reception), not a failed run
 
   template <class V>
   void visit(V& v) {

@@ -19,13 +19,16 @@ struct RunSummary {
   ChannelSummaries channels;
   ProcessSummaries processes;
   std::vector<std::string> problems;  // empty when ok
+  // Said, not failed: messages the monitor itself missed (its own reception; the graph's
+  // processes count and report their own losses, which are problems).
+  std::vector<std::string> notes;
   bool ok = false;
 };
 
 // Fills problems and ok from the channels and processes.
 void judge(RunSummary& s, const Thresholds& t = {});
 
-// One line of JSON: lcm_url, duration_s, events, channels, processes, problems, ok.
+// One line of JSON: lcm_url, duration_s, events, channels, processes, problems, notes, ok.
 std::string to_json(const RunSummary& s);
 
 // The human-readable report: channel table, process table, verdict.

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "log_validation.hpp"
+#include "version.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app(
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   bool json_only = false;
   app.add_option("LOG", path, "LCM log file")->required();
   app.add_flag("--json-only", json_only, "print only the JSON summary line");
+  traverse::add_version_flag(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

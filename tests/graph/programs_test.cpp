@@ -15,7 +15,8 @@ namespace {
 // in bin/traverse-* is a process.
 const std::set<std::string> kTools = {
     "validate",          "launch",       "frontend-bench", "pgo", "pgo-ceres", "cloud-eval",
-    "densifier-compare", "mapper-bench", "sim-realism", "annotator-eval"};
+    "densifier-compare", "mapper-bench", "sim-realism", "annotator-eval",
+    "export"};
 
 // Processes that need inputs besides a config to start at all get them here; the config must
 // still be checked, and named when wrong.
