@@ -73,16 +73,39 @@ std::optional<std::string> validate(const DeskewConfig& c) {
   return check.problem();
 }
 
+std::optional<std::string> validate(const MotionPriorConfig& c) {
+  ConfigCheck check;
+  check.require(
+      c.source == "imu" || c.source == "odometry" || c.source == "both" || c.source == "none",
+      "source", "must be one of imu, odometry, both, none, got '" + c.source + "'");
+  check.in_range<int64_t>("odometry_max_gap_us", c.odometry_max_gap_us, 1, 60'000'000);
+  check.in_range<int64_t>("odometry_max_extrapolation_us", c.odometry_max_extrapolation_us, 0,
+                          10'000'000);
+  check.in_range("odometry_sigma_xy_m", c.odometry_sigma_xy_m, 0.0, 10.0);
+  check.in_range("odometry_sigma_xy_per_m", c.odometry_sigma_xy_per_m, 0.0, 10.0);
+  check.in_range("odometry_sigma_theta_rad", c.odometry_sigma_theta_rad, 0.0, M_PI);
+  check.in_range("odometry_sigma_theta_per_m", c.odometry_sigma_theta_per_m, 0.0, 10.0);
+  check.in_range("odometry_sigma_theta_per_rad", c.odometry_sigma_theta_per_rad, 0.0, 10.0);
+  check.in_range("search_sigmas", c.search_sigmas, 0.5, 100.0);
+  check.in_range("odometry_check_margin", c.odometry_check_margin, 0.0, 2.0);
+  check.in_range("odometry_check_sigmas", c.odometry_check_sigmas, 0.0, 100.0);
+  check.in_range("search_min_linear_m", c.search_min_linear_m, 0.0, 100.0);
+  check.in_range("search_min_angular_rad", c.search_min_angular_rad, 0.0, M_PI);
+  return check.problem();
+}
+
 std::optional<std::string> validate(const FrontendConfig& c) {
   ConfigCheck check;
   check.not_empty("scan_channel", c.scan_channel);
   check.not_empty("imu_channel", c.imu_channel);
+  check.not_empty("odometry_channel", c.odometry_channel);
   check.not_empty("pose_channel", c.pose_channel);
   check.nested("T_base_laser", validate(c.T_base_laser));
   check.nested("initial_pose", validate(c.initial_pose));
   check.nested("map", validate(c.map));
   check.nested("matcher", validate(c.matcher));
   check.nested("deskew", validate(c.deskew));
+  check.nested("motion_prior", validate(c.motion_prior));
   if (check.problem()) return check.problem();
   // The searches' windows in cells of the level each runs on: the recovery search on the
   // coarsest, the wide search on level 1 (or 0 with one level).

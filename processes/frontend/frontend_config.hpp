@@ -195,9 +195,76 @@ struct DeskewConfig {
   }
 };
 
+// The motion prior (motion_prior.hpp): what predicts each scan's pose besides the last poses.
+struct MotionPriorConfig {
+  // imu | odometry | both | none. both: translation by wheel odometry, rotation by the IMU where
+  // its samples cover the step, else by odometry; odometry: both by odometry; imu: rotation by
+  // the IMU, translation by the velocity of the last poses; none: the last poses alone. What the
+  // source names but the stream does not carry (no odometry, the IMU silent) falls back to the
+  // next of these, counted in the status (odometry_missing, _gap, _stale). A rig without
+  // odometry or IMU runs alike under every value.
+  std::string source = "both";
+  // Odometry samples further apart than this around a time do not give the pose at it (the
+  // odometry stopped or lost messages): the prediction falls back.
+  int64_t odometry_max_gap_us = 1'000'000;
+  // A scan up to this after the newest odometry sample is predicted at the newest rate (the
+  // sample behind a scan's last point, odometry arriving late); later, the prediction falls back.
+  int64_t odometry_max_extrapolation_us = 200'000;
+  // Standard deviation of an odometry step, added to what the messages' covariance says:
+  // a constant, per metre travelled and per radian turned (a Pioneer's wheels: a few cm per
+  // metre, several degrees per turn where the floor lets them slip).
+  double odometry_sigma_xy_m = 0.02;
+  double odometry_sigma_xy_per_m = 0.1;
+  double odometry_sigma_theta_rad = 0.01;
+  double odometry_sigma_theta_per_m = 0.05;
+  double odometry_sigma_theta_per_rad = 0.1;
+  // With odometry, the wide search (sparse scans) and the recovery search (a failed match) are
+  // centred on the odometry prediction and span search_sigmas of its step's standard deviation,
+  // at least search_min_linear_m and search_min_angular_rad, at most the matcher's windows; the
+  // recovery search then also leaves out the last pose (odometry says whether the base moved).
+  double search_sigmas = 3.0;
+  // [RMS of 1 - M, unitless] Odometry's prediction is checked against the scan on a scanner's
+  // stream: where the prediction without odometry (IMU and the last poses) differs from it by a
+  // map cell or 0.01 rad, the scan is matched from both, and the match without odometry is taken
+  // if its residual is lower by more than this (or it passes the unverified check that the other
+  // fails) and the two poses lie more than odometry_check_sigmas apart by the covariance of the
+  // match with odometry (the scan tells them apart: along a corridor's axis it does not, and the
+  // map made at the last pose would favour standing still), counted odometry_overruled. 0
+  // trusts odometry always.
+  double odometry_check_margin = 0.005;
+  double odometry_check_sigmas = 3.0;
+  // Use odometry on a log subsampled by travel (MatcherConfig::wide_search_gap_us: the median of
+  // the last five intervals above it) too. Such logs' sparse path (step prior, ensemble, lag) does
+  // better without it on the CARMEN sets: intel RPE over 1 m / 10 m 0.065 / 0.131 m with it,
+  // 0.059 / 0.119 m without (scripts/eval-carmen.sh intel --stages frontend --offline). A gap in
+  // a scanner's stream (a sparse scan of a stream that is not subsampled) takes odometry always.
+  bool subsampled_logs = false;
+  double search_min_linear_m = 0.3;
+  double search_min_angular_rad = 0.15;
+
+  template <class V>
+  void visit(V& v) {
+    v("source", source);
+    v("odometry_max_gap_us", odometry_max_gap_us);
+    v("odometry_max_extrapolation_us", odometry_max_extrapolation_us);
+    v("odometry_sigma_xy_m", odometry_sigma_xy_m);
+    v("odometry_sigma_xy_per_m", odometry_sigma_xy_per_m);
+    v("odometry_sigma_theta_rad", odometry_sigma_theta_rad);
+    v("odometry_sigma_theta_per_m", odometry_sigma_theta_per_m);
+    v("odometry_sigma_theta_per_rad", odometry_sigma_theta_per_rad);
+    v("search_sigmas", search_sigmas);
+    v("odometry_check_margin", odometry_check_margin);
+    v("odometry_check_sigmas", odometry_check_sigmas);
+    v("subsampled_logs", subsampled_logs);
+    v("search_min_linear_m", search_min_linear_m);
+    v("search_min_angular_rad", search_min_angular_rad);
+  }
+};
+
 struct FrontendConfig {
   std::string scan_channel = channels::kScanHorizontal;
   std::string imu_channel = channels::kImu;
+  std::string odometry_channel = channels::kOdometry;
   std::string pose_channel = channels::kPoseFrontend;
   Pose2Config T_base_laser;  // the horizontal scanner in the base frame
   // Pose of the base at the first scan in the map frame, T_map_base: where the trajectory starts
@@ -208,17 +275,20 @@ struct FrontendConfig {
   MapConfig map;
   MatcherConfig matcher;
   DeskewConfig deskew;
+  MotionPriorConfig motion_prior;
 
   template <class V>
   void visit(V& v) {
     v("scan_channel", scan_channel);
     v("imu_channel", imu_channel);
+    v("odometry_channel", odometry_channel);
     v("pose_channel", pose_channel);
     v("T_base_laser", T_base_laser);
     v("initial_pose", initial_pose);
     v("map", map);
     v("matcher", matcher);
     v("deskew", deskew);
+    v("motion_prior", motion_prior);
   }
 };
 
@@ -226,6 +296,7 @@ struct FrontendConfig {
 std::optional<std::string> validate(const MapConfig& config);
 std::optional<std::string> validate(const MatcherConfig& config);
 std::optional<std::string> validate(const DeskewConfig& config);
+std::optional<std::string> validate(const MotionPriorConfig& config);
 std::optional<std::string> validate(const FrontendConfig& config);
 
 }  // namespace traverse::frontend

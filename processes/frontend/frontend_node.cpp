@@ -10,6 +10,8 @@ FrontendNode::FrontendNode(Bus& bus, const FrontendConfig& config, CounterSink c
   bus_.subscribe<planar_scan_t>(config_.scan_channel,
                                 [this](const planar_scan_t& m) { on_scan(m); });
   bus_.subscribe<imu_t>(config_.imu_channel, [this](const imu_t& m) { on_imu(m); });
+  bus_.subscribe<odometry_t>(config_.odometry_channel,
+                             [this](const odometry_t& m) { on_odometry(m); });
 }
 
 void FrontendNode::on_scan(const planar_scan_t& msg) {
@@ -24,11 +26,28 @@ void FrontendNode::on_imu(const imu_t& msg) {
   flush();
 }
 
+void FrontendNode::on_odometry(const odometry_t& msg) {
+  OdometrySample o;
+  o.utime = msg.utime;
+  o.T_odom_base = Pose2(msg.x, msg.y, msg.theta);
+  for (int i = 0; i < 9; ++i) {
+    o.pose_covariance(i / 3, i % 3) = msg.pose_covariance[i];
+    o.velocity_covariance(i / 3, i % 3) = msg.velocity_covariance[i];
+  }
+  o.velocity = Eigen::Vector3d(msg.velocity[0], msg.velocity[1], msg.velocity[2]);
+  if (frontend_->add_odometry(o)) last_odometry_utime_ = msg.utime;
+  flush();
+}
+
 void FrontendNode::flush(bool all) {
-  const auto& last_imu = last_imu_utime_;
+  const auto covered = [](const std::optional<int64_t>& last, int64_t utime) {
+    return !last || *last >= utime;
+  };
   while (!pending_.empty()) {
     const Scan& scan = pending_.front();
-    const bool ready = all || !last_imu || *last_imu >= scan.utime_last ||
+    const bool ready = all ||
+                       (covered(last_imu_utime_, scan.utime_last) &&
+                        covered(last_odometry_utime_, scan.utime_last)) ||
                        pending_.back().utime_last - scan.utime_last >= config_.deskew.imu_wait_us;
     if (!ready) break;
     const FrontendResult result = frontend_->process(scan);

@@ -1,10 +1,11 @@
-// Adapts LCM messages to the frontend (frontend.hpp, made by make_frontend()): planar_scan_t and
-// imu_t in, pose2d_t out (parent "map", child "base", one per scan, FLAG_PREDICTED when the
-// frontend says kPredicted), the frontend's counters into the process status. A scan waits until
-// IMU samples cover its last point (or until a scan imu_wait_us later has arrived, or for good when
-// no IMU publishes), because a log player delivers a sweep at its first point's time, before the
-// IMU samples taken during the sweep. A frontend may give a pose a scan late (on a log subsampled
-// by travel: MatcherConfig:: sparse_lag), the last one at shutdown (flush(true)).
+// Adapts LCM messages to the frontend (frontend.hpp, made by make_frontend()): planar_scan_t,
+// imu_t and odometry_t in, pose2d_t out (parent "map", child "base", one per scan, FLAG_PREDICTED
+// when the frontend says kPredicted), the frontend's counters into the process status. A scan waits
+// until IMU samples cover its last point (or until a scan imu_wait_us later has arrived, or for
+// good when no IMU publishes), because a log player delivers a sweep at its first point's time,
+// before the IMU samples taken during the sweep; likewise for odometry, once any has come (its
+// messages may trail the scan). A frontend may give a pose a scan late (on a log subsampled by
+// travel: MatcherConfig:: sparse_lag), the last one at shutdown (flush(true)).
 #pragma once
 
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include "bus.hpp"
 #include "frontend.hpp"
 #include "traverse/imu_t.hpp"
+#include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 
 namespace traverse::frontend {
@@ -36,6 +38,7 @@ class FrontendNode {
  private:
   void on_scan(const planar_scan_t& msg);
   void on_imu(const imu_t& msg);
+  void on_odometry(const odometry_t& msg);
   void publish(const FrontendResult& result);
 
   Bus& bus_;
@@ -43,7 +46,8 @@ class FrontendNode {
   std::unique_ptr<Frontend> frontend_;
   CounterSink counters_;
   std::deque<Scan> pending_;
-  std::optional<int64_t> last_imu_utime_;  // [us] of the newest IMU sample the frontend took
+  std::optional<int64_t> last_imu_utime_;       // [us] of the newest IMU sample the frontend took
+  std::optional<int64_t> last_odometry_utime_;  // [us] of the newest odometry sample it took
 };
 
 }  // namespace traverse::frontend

@@ -14,17 +14,8 @@
 namespace traverse::frontend {
 namespace {
 
-constexpr int64_t kPeriodUs = 20964;  // 47.7 Hz
-
-// A small, fast setup: 1,800-point sweeps of 300 degrees in the synthetic room.
-synthetic::SweepSpec small_sweep(int64_t utime_first) {
-  synthetic::SweepSpec spec;
-  spec.n_ranges = 1800;
-  spec.angle_step = 300.0 * M_PI / 180.0 / 1799.0;
-  spec.utime_first = utime_first;
-  spec.noise_sigma_m = 0.002;
-  return spec;
-}
+using testing::kPeriodUs;
+using testing::small_sweep;
 
 // Walks, weaves and turns through the room; returns the final pose error [m] and [rad].
 struct RoomRun {

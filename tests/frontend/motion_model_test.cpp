@@ -60,8 +60,9 @@ TEST(MotionModel, OdometryGivesTheStepWhereItCoversTheInterval) {
   const Pose2 expected = Pose2(0.1, 0.0, 0.0) * Pose2::exp(Eigen::Vector3d(2.0, 0.0, 0.2));
   EXPECT_LT((predicted.translation() - expected.translation()).norm(), 1e-9);
   EXPECT_NEAR(predicted.theta(), expected.theta(), 1e-9);
-  // Beyond the odometry's last sample the poses' velocity predicts again.
-  const Pose2 beyond = motion.extrapolate(3'200'000, false, false);
+  // Past the odometry's last sample by more than motion_prior.odometry_max_extrapolation_us
+  // (0.2 s) the poses' velocity predicts again.
+  const Pose2 beyond = motion.extrapolate(3'400'000, false, false);
   EXPECT_NEAR(beyond.x(), 0.1 + 0.1 * 2.0, 1e-9);
   OdometrySample stale;
   stale.utime = 2'000'000;

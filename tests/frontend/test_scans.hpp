@@ -13,6 +13,18 @@
 
 namespace traverse::frontend::testing {
 
+constexpr int64_t kPeriodUs = 20964;  // 47.7 Hz
+
+// A small, fast setup: 1,800-point sweeps of 300 degrees with 2 mm range noise.
+inline synthetic::SweepSpec small_sweep(int64_t utime_first) {
+  synthetic::SweepSpec spec;
+  spec.n_ranges = 1800;
+  spec.angle_step = 300.0 * M_PI / 180.0 / 1799.0;
+  spec.utime_first = utime_first;
+  spec.noise_sigma_m = 0.002;
+  return spec;
+}
+
 // End points in the base frame of a full-circle scan from T_world_base (no motion), with
 // Gaussian range noise.
 inline std::vector<Eigen::Vector2d> static_scan(const synthetic::World& world,

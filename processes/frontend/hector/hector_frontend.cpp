@@ -39,8 +39,10 @@ HectorFrontend::HectorFrontend(const FrontendConfig& config)
       T_initial_(config.initial_pose.pose()),
       scan_points_(config.T_base_laser.pose(), config.matcher.min_range_m,
                    config.matcher.max_range_m),
-      motion_(T_initial_, rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
-                                       config.deskew.imu_yaw_rad)),
+      motion_(T_initial_,
+              rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
+                           config.deskew.imu_yaw_rad),
+              config.motion_prior),
       map_(config.map) {}
 
 bool HectorFrontend::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) {
@@ -111,31 +113,42 @@ Measurement HectorFrontend::measure(const Scan& scan) {
     r.covariance = Eigen::Matrix3d::Identity() * 1e-12;
     d.matched_points = d.valid_points;
   } else {
-    const Pose2 T_pred = motion_.extrapolate(scan.utime_last, use_imu, r.sparse);
-    d.T_map_base_predicted = T_pred;
+    // A log subsampled by travel takes odometry only if configured (motion_prior.subsampled_logs).
+    const MotionModel::Prediction with =
+        motion_.predict(scan.utime_last, use_imu, r.sparse,
+                        !m.subsampled_by_travel || config_.motion_prior.subsampled_logs);
     deskew();
-    // Should the prediction fail, the recovery also searches around the last pose (no motion).
-    const Pose2& T_last = motion_.last_pose();
-    std::vector<Pose2> other_centres;
-    if (between(T_pred, T_last).translation().norm() > config_.map.resolution_m ||
-        std::abs(between(T_pred, T_last).theta()) > 0.01) {
-      other_centres.push_back(T_last);
-    }
-    // The step prior holds for a log subsampled by travel, not for a pause in a scanner's stream
-    // (freiburg-079: 40 gaps over 0.5 s, the robot standing still).
     m.points_matched = subsample(points.points_base, config_.matcher.min_point_spacing_m);
-    const MatchResult match =
-        r.sparse
-            ? match_scan_wide(map_, m.points_matched, {T_pred}, config_.matcher,
-                              m.subsampled_by_travel ? &T_last : nullptr)
-            : match_scan(map_, m.points_matched, T_pred, config_.matcher, -1, 0, other_centres);
+    Attempt attempt = match_from(m, with);
+    // Odometry's step is checked against the scan (a scanner's stream): matched also from the
+    // prediction without it, the result that fits clearly better stands (a wheel slipped, the
+    // odometry's stamps are off), if the scan tells the two apart (not along a corridor's axis,
+    // where the map made at the last pose favours standing still).
+    if (with.odometry && !r.sparse && config_.motion_prior.odometry_check_margin > 0.0) {
+      const MotionModel::Prediction without =
+          motion_.predict(scan.utime_last, use_imu, r.sparse, false);
+      const Pose2 d_pred = between(with.T_map_base, without.T_map_base);
+      if (d_pred.translation().norm() > config_.map.resolution_m ||
+          std::abs(d_pred.theta()) > 0.01) {
+        Attempt other = match_from(m, without);
+        if (better(other, attempt, config_.motion_prior.odometry_check_margin) &&
+            apart(other, attempt, config_.motion_prior.odometry_check_sigmas)) {
+          ++counters_.odometry_overruled;
+          attempt = std::move(other);
+        }
+      }
+    }
+    count_odometry(attempt.prediction);
+    const Pose2& T_pred = attempt.prediction.T_map_base;
+    d.T_map_base_predicted = T_pred;
+    const MatchResult& match = attempt.match;
     if (match.searched) ++counters_.scans_searched;
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
     // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes
     // from a scan that fits nowhere (people round the scanner, a view the map has not seen).
     // Sparse scans are predicted too poorly for this (their steps of a metre are what the wide
     // search is for).
-    if (!r.sparse && unverified(match, T_pred, config_.matcher)) {
+    if (attempt.unverified) {
       ++counters_.scans_unverified;
       take_prediction(m, T_pred);
       d.residual_rms = match.residual_rms;
@@ -147,6 +160,78 @@ Measurement HectorFrontend::measure(const Scan& scan) {
   ++counters_.scans_matched;
   m.points = std::move(points.points_base);
   return m;
+}
+
+HectorFrontend::Attempt HectorFrontend::match_from(const Measurement& m,
+                                                   const MotionModel::Prediction& p) const {
+  const Pose2& T_pred = p.T_map_base;
+  const Pose2& T_last = motion_.last_pose();
+  const bool sparse = m.result.sparse;
+  // Should the prediction fail, the recovery also searches around the last pose (no motion),
+  // unless odometry gave the step.
+  std::vector<Pose2> other_centres;
+  if (!p.odometry && (between(T_pred, T_last).translation().norm() > config_.map.resolution_m ||
+                      std::abs(between(T_pred, T_last).theta()) > 0.01)) {
+    other_centres.push_back(T_last);
+  }
+  const MatcherConfig matcher = search_windows(p);
+  Attempt a;
+  a.prediction = p;
+  // The step prior holds for a log subsampled by travel, not for a pause in a scanner's stream
+  // (freiburg-079: 40 gaps over 0.5 s, the robot standing still).
+  a.match = sparse ? match_scan_wide(map_, m.points_matched, {T_pred}, matcher,
+                                     m.subsampled_by_travel ? &T_last : nullptr)
+                   : match_scan(map_, m.points_matched, T_pred, matcher, -1, 0, other_centres);
+  a.unverified = !sparse && unverified(a.match, T_pred, config_.matcher);
+  return a;
+}
+
+bool HectorFrontend::better(const Attempt& a, const Attempt& b, double margin) {
+  if (a.unverified != b.unverified) return !a.unverified;
+  return a.match.residual_rms + margin < b.match.residual_rms;
+}
+
+bool HectorFrontend::apart(const Attempt& a, const Attempt& b, double sigmas) {
+  const Eigen::Vector3d d = between(b.match.T_map_base, a.match.T_map_base).log();
+  const Eigen::Matrix3d& C = b.match.covariance;
+  if (C.determinant() <= 0.0) return true;
+  return d.dot(C.ldlt().solve(d)) > sigmas * sigmas;
+}
+
+void HectorFrontend::count_odometry(const MotionModel::Prediction& p) {
+  if (p.odometry) {
+    ++counters_.odometry_predictions;
+    if (p.odometry->extrapolated) ++counters_.odometry_extrapolated;
+    return;
+  }
+  // A stream that never carried odometry is not short of it.
+  if (counters_.odometry_samples == 0) return;
+  switch (p.odometry_miss) {
+    case OdometryMiss::kMissing:
+      ++counters_.odometry_missing;
+      break;
+    case OdometryMiss::kGap:
+      ++counters_.odometry_gap;
+      break;
+    case OdometryMiss::kStale:
+      ++counters_.odometry_stale;
+      break;
+    case OdometryMiss::kNone:
+      break;  // the source leaves odometry out
+  }
+}
+
+MatcherConfig HectorFrontend::search_windows(const MotionModel::Prediction& p) const {
+  MatcherConfig c = config_.matcher;
+  if (!p.odometry) return c;
+  const MotionPrior& prior = motion_.prior();
+  const Eigen::Matrix3d& cov = p.odometry->covariance;
+  c.wide_search_linear_window_m = prior.linear_window_m(cov, c.wide_search_linear_window_m);
+  c.wide_search_angular_window_rad =
+      prior.angular_window_rad(cov, c.wide_search_angular_window_rad);
+  c.search_linear_window_m = prior.linear_window_m(cov, c.search_linear_window_m);
+  c.search_angular_window_rad = prior.angular_window_rad(cov, c.search_angular_window_rad);
+  return c;
 }
 
 void HectorFrontend::take_prediction(Measurement& m, const Pose2& T_predicted) const {
@@ -234,6 +319,12 @@ void HectorFrontend::report(const CounterSink& sink) const {
   sink("imu_dropped", static_cast<double>(c.imu_dropped));
   sink("odometry_samples", static_cast<double>(c.odometry_samples));
   sink("odometry_dropped", static_cast<double>(c.odometry_dropped));
+  sink("odometry_predictions", static_cast<double>(c.odometry_predictions));
+  sink("odometry_extrapolated", static_cast<double>(c.odometry_extrapolated));
+  sink("odometry_overruled", static_cast<double>(c.odometry_overruled));
+  sink("odometry_missing", static_cast<double>(c.odometry_missing));
+  sink("odometry_gap", static_cast<double>(c.odometry_gap));
+  sink("odometry_stale", static_cast<double>(c.odometry_stale));
 }
 
 }  // namespace traverse::frontend

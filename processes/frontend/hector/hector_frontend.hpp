@@ -2,8 +2,10 @@
 // (two_phase.hpp). Measuring a scan:
 //   1. keep the valid readings (finite, inside the scanner's and the config's range; too few:
 //      the pose is predicted, flagged);
-//   2. predict the pose at the scan's last point (motion_model.hpp: IMU, odometry, the velocity
-//      of the last poses, or the average step of a sparse log);
+//   2. predict the pose at the scan's last point (motion_model.hpp: IMU, odometry as the motion
+//      prior combines them (../motion_prior.hpp), the velocity of the last poses, or the average
+//      step of a sparse log); with odometry, the searches below are centred on the prediction and
+//      sized by the odometry step's covariance, and the recovery search leaves the last pose out;
 //   3. undo the motion during the sweep (deskew.hpp);
 //   4. match the points against the map pyramid, coarse to fine, from the prediction
 //      (scan_matcher.hpp); sparse scans, those more than matcher.wide_search_gap_us after the
@@ -24,6 +26,7 @@
 #include "frontend_config.hpp"
 #include "map_pyramid.hpp"
 #include "motion_model.hpp"
+#include "scan_matcher.hpp"
 #include "scan_points.hpp"
 #include "two_phase.hpp"
 
@@ -63,7 +66,15 @@ class HectorFrontend final : public TwoPhaseFrontend {
     int64_t imu_samples = 0;
     int64_t imu_dropped = 0;  // IMU samples not after the previous one, or not finite
     int64_t odometry_samples = 0;
-    int64_t odometry_dropped = 0;
+    int64_t odometry_dropped = 0;  // not after the previous sample, or not finite
+    // Scans predicted with odometry's step (of which extrapolated past the newest sample), and
+    // scans of a stream with odometry predicted without it, by reason (motion_prior.hpp).
+    int64_t odometry_predictions = 0;
+    int64_t odometry_extrapolated = 0;
+    int64_t odometry_overruled = 0;  // the match without odometry's step fit clearly better
+    int64_t odometry_missing = 0;
+    int64_t odometry_gap = 0;
+    int64_t odometry_stale = 0;
   };
   // What an integration changes besides the map's cells: undone with them.
   struct Integrated {
@@ -76,6 +87,20 @@ class HectorFrontend final : public TwoPhaseFrontend {
   // the motion prior's.
   void take_prediction(Measurement& m, const Pose2& T_predicted) const;
   bool map_update_due(const Pose2& T_map_base) const;
+  // A match from one prediction; unverified: see measure() (a scanner's stream only).
+  struct Attempt {
+    MotionModel::Prediction prediction;
+    MatchResult match;
+    bool unverified = false;
+  };
+  Attempt match_from(const Measurement& m, const MotionModel::Prediction& prediction) const;
+  // a fits better than b: verified where b is not, else a residual lower by more than margin.
+  static bool better(const Attempt& a, const Attempt& b, double margin);
+  // a's pose lies more than `sigmas` standard deviations of b's covariance from b's.
+  static bool apart(const Attempt& a, const Attempt& b, double sigmas);
+  void count_odometry(const MotionModel::Prediction& prediction);
+  // The matcher's config with the searches' windows sized by the prediction's odometry step.
+  MatcherConfig search_windows(const MotionModel::Prediction& prediction) const;
 
   FrontendConfig config_;
   Pose2 T_initial_;

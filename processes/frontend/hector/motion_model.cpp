@@ -12,23 +12,11 @@ constexpr int64_t kImuStaleUs = 500'000;
 constexpr double kVelocitySmoothingS = 0.1;
 // Weight of the newest step in the average step of sparse scans.
 constexpr double kSparseStepSmoothing = 0.3;
-// Odometry samples older than this (before the newest) are dropped.
-constexpr int64_t kOdometryKeepUs = 10'000'000;
-
-// T_odom_base at t, geodesically between the samples around it (`samples` covers t).
-Pose2 odometry_at(const std::deque<OdometrySample>& samples, int64_t t) {
-  const auto it = std::lower_bound(samples.begin(), samples.end(), t,
-                                   [](const OdometrySample& s, int64_t u) { return s.utime < u; });
-  if (it->utime == t || it == samples.begin()) return it->T_odom_base;
-  const OdometrySample& a = *(it - 1);
-  return interpolate(a.T_odom_base, it->T_odom_base,
-                     static_cast<double>(t - a.utime) / static_cast<double>(it->utime - a.utime));
-}
-
 }  // namespace
 
-MotionModel::MotionModel(const Pose2& T_map_base_initial, const Eigen::Matrix3d& R_base_imu)
-    : yaw_(R_base_imu) {
+MotionModel::MotionModel(const Pose2& T_map_base_initial, const Eigen::Matrix3d& R_base_imu,
+                         const MotionPriorConfig& prior)
+    : yaw_(R_base_imu), prior_(prior) {
   state_.T_map_base_last = T_map_base_initial;
 }
 
@@ -36,15 +24,7 @@ bool MotionModel::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity
   return angular_velocity_imu.allFinite() && yaw_.add(utime, angular_velocity_imu);
 }
 
-bool MotionModel::add_odometry(const OdometrySample& o) {
-  if (!(o.T_odom_base.vector().allFinite() && o.velocity.allFinite())) return false;
-  if (!odometry_.empty() && o.utime <= odometry_.back().utime) return false;
-  odometry_.push_back(o);
-  while (odometry_.size() > 2 && odometry_.back().utime - odometry_[1].utime > kOdometryKeepUs) {
-    odometry_.pop_front();
-  }
-  return true;
-}
+bool MotionModel::add_odometry(const OdometrySample& o) { return prior_.add_odometry(o); }
 
 void MotionModel::add_pose(int64_t utime, const Pose2& T_map_base,
                            const Eigen::Matrix3d& covariance, bool sparse) {
@@ -76,7 +56,8 @@ void MotionModel::add_prediction(int64_t utime, const Pose2& T_map_base,
 }
 
 bool MotionModel::imu_covers(int64_t from, int64_t to) const {
-  return !yaw_.empty() && yaw_.first_utime() <= from && yaw_.last_utime() + kImuStaleUs >= to;
+  return prior_.uses_imu() && !yaw_.empty() && yaw_.first_utime() <= from &&
+         yaw_.last_utime() + kImuStaleUs >= to;
 }
 
 bool MotionModel::subsampled_by_travel(int64_t gap_us) const {
@@ -84,25 +65,27 @@ bool MotionModel::subsampled_by_travel(int64_t gap_us) const {
          state_.recent_intervals_us.percentile(50) > static_cast<double>(gap_us);
 }
 
-std::optional<Pose2> MotionModel::odometry_motion(int64_t t0, int64_t t1) const {
-  if (odometry_.empty() || odometry_.front().utime > std::min(t0, t1) ||
-      odometry_.back().utime < std::max(t0, t1)) {
-    return std::nullopt;
-  }
-  return between(odometry_at(odometry_, t0), odometry_at(odometry_, t1));
-}
-
-Pose2 MotionModel::extrapolate(int64_t utime, bool use_imu, bool sparse) const {
+MotionModel::Prediction MotionModel::predict(int64_t utime, bool use_imu, bool sparse,
+                                             bool with_odometry) const {
   const State& s = state_;
-  if (const auto step = odometry_motion(s.last_utime, utime); step && s.initialised) {
-    const double turn = use_imu ? yaw_.heading_change(s.last_utime, utime) : step->theta();
-    return s.T_map_base_last * Pose2(step->x(), step->y(), turn);
+  Prediction p;
+  if (s.initialised && with_odometry)
+    p.odometry = prior_.odometry_step(s.last_utime, utime, &p.odometry_miss);
+  if (p.odometry) {
+    const Pose2& step = p.odometry->T_base0_base1;
+    const double turn = use_imu ? yaw_.heading_change(s.last_utime, utime) : step.theta();
+    p.T_map_base = s.T_map_base_last * Pose2(step.x(), step.y(), turn);
+    return p;
   }
-  if (sparse && s.sparse_step && !use_imu) return s.T_map_base_last * Pose2::exp(*s.sparse_step);
+  if (sparse && s.sparse_step && !use_imu) {
+    p.T_map_base = s.T_map_base_last * Pose2::exp(*s.sparse_step);
+    return p;
+  }
   const int64_t horizon = std::min(utime - s.last_utime, 2 * s.last_interval_us);
   Eigen::Vector3d xi = s.velocity * (1e-6 * static_cast<double>(horizon));
   if (use_imu) xi.z() = yaw_.heading_change(s.last_utime, utime);
-  return s.T_map_base_last * Pose2::exp(xi);
+  p.T_map_base = s.T_map_base_last * Pose2::exp(xi);
+  return p;
 }
 
 }  // namespace traverse::frontend

@@ -2,13 +2,16 @@
 // matcher measured go in (add_pose), and so do IMU yaw rates and wheel odometry; the pose at a
 // later time comes out (extrapolate), and the heading change and velocity within a sweep for
 // de-skewing it (deskew.hpp).
-//   - Heading change: the IMU's yaw rate integrated (yaw_integrator.hpp) when its samples cover
-//     the time since the last pose, else the angular velocity of the last poses.
-//   - Translation: wheel odometry's relative motion when its samples cover the time since the
-//     last pose, else the velocity of the last poses over the elapsed time, over at most twice
-//     the last interval (after a pause it would predict an arbitrarily long step). The velocity
-//     is differenced from consecutive poses and averaged exponentially over about 0.1 s (poses a
-//     few milliseconds apart are noisy to difference).
+//   - The motion prior (../motion_prior.hpp, config motion_prior.source) says which of wheel
+//     odometry and the IMU are used and how they combine: with odometry's step since the last
+//     pose, the translation is odometry's and the rotation the IMU's (source both, IMU covering)
+//     or odometry's.
+//   - Heading change otherwise: the IMU's yaw rate integrated (yaw_integrator.hpp) when its
+//     samples cover the time since the last pose, else the angular velocity of the last poses.
+//   - Translation otherwise: the velocity of the last poses over the elapsed time, over at most
+//     twice the last interval (after a pause it would predict an arbitrarily long step). The
+//     velocity is differenced from consecutive poses and averaged exponentially over about 0.1 s
+//     (poses a few milliseconds apart are noisy to difference).
 //   - Sparse scans (far apart in time, see MatcherConfig::wide_search_gap_us) of a log
 //     subsampled by travel (the CARMEN sets) without IMU or odometry: their times say little
 //     about the motion, so the prediction is the average of the last sparse steps. Such a log
@@ -21,10 +24,10 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <deque>
 #include <optional>
 
 #include "frontend.hpp"
+#include "motion_prior.hpp"
 #include "recent_values.hpp"
 #include "se2.hpp"
 #include "yaw_integrator.hpp"
@@ -34,7 +37,8 @@ namespace traverse::frontend {
 class MotionModel {
  public:
   // Before the first pose the last pose is T_map_base_initial (where the trajectory starts).
-  MotionModel(const Pose2& T_map_base_initial, const Eigen::Matrix3d& R_base_imu);
+  MotionModel(const Pose2& T_map_base_initial, const Eigen::Matrix3d& R_base_imu,
+              const MotionPriorConfig& prior = {});
 
   // Samples not after the previous one, or not finite, are refused (false).
   bool add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu);
@@ -55,7 +59,8 @@ class MotionModel {
   // (vx [m/s], vy [m/s], omega [rad/s]) in the base frame, from the last poses.
   const Eigen::Vector3d& velocity() const { return state_.velocity; }
 
-  // IMU samples reach back to `from` and are recent at `to` (not older than 0.5 s).
+  // IMU samples reach back to `from` and are recent at `to` (not older than 0.5 s), and the
+  // motion prior's source includes the IMU.
   bool imu_covers(int64_t from, int64_t to) const;
   // Heading change of the base from t0 to t1 [rad] by the IMU (imu_covers() must hold).
   double imu_heading_change(int64_t t0, int64_t t1) const { return yaw_.heading_change(t0, t1); }
@@ -65,7 +70,17 @@ class MotionModel {
 
   // The pose at `utime` (after the last pose), see the header. use_imu: imu_covers() from the
   // last pose to utime; sparse: the scan is a sparse one.
-  Pose2 extrapolate(int64_t utime, bool use_imu, bool sparse) const;
+  Pose2 extrapolate(int64_t utime, bool use_imu, bool sparse) const {
+    return predict(utime, use_imu, sparse).T_map_base;
+  }
+  struct Prediction {
+    Pose2 T_map_base;
+    std::optional<OdometryStep> odometry;  // the odometry step it used, with its covariance
+    OdometryMiss odometry_miss = OdometryMiss::kNone;  // why not, where the source names it
+  };
+  // with_odometry false: as if no odometry had come (the prediction odometry would overrule).
+  Prediction predict(int64_t utime, bool use_imu, bool sparse, bool with_odometry = true) const;
+  const MotionPrior& prior() const { return prior_; }
 
   struct State {
     bool initialised = false;
@@ -82,11 +97,8 @@ class MotionModel {
   void restore(const State& state) { state_ = state; }
 
  private:
-  // The relative motion by wheel odometry from t0 to t1, if its samples cover both times.
-  std::optional<Pose2> odometry_motion(int64_t t0, int64_t t1) const;
-
   YawIntegrator yaw_;
-  std::deque<OdometrySample> odometry_;
+  MotionPrior prior_;
   State state_;
 };
 
