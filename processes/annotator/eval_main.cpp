@@ -27,6 +27,7 @@
 #include "coverage.hpp"
 #include "json_escape.hpp"
 #include "lcm_log.hpp"
+#include "version.hpp"
 #include "traverse/annotations_t.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/planar_scan_t.hpp"
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
   app.add_option("--laser-x", o.laser_x, "[m] horizontal scanner in the base frame (rig.yaml)");
   app.add_option("--laser-y", o.laser_y, "[m]");
   app.add_option("--laser-yaw", o.laser_yaw, "[rad]");
+  traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
   std::map<int64_t, KeyRecord> keys;
