@@ -61,7 +61,7 @@ ensure_run() {  # ROUTE SEED
   mv "$dir/coverage.lcmlog.tmp" "$dir/coverage.lcmlog"
   if [[ -z $keep ]]; then
     local sim_log
-    sim_log="$(python3 -c 'import json,sys; print(json.loads(open(sys.argv[1]).read().splitlines()[-1]).get("sim_log",""))' "$dir.route.out" 2>/dev/null || true)"
+    sim_log="$(last_json_line "$dir.route.out" | "$PYTHON" "$ROOT/scripts/conf.py" get - sim_log 2>/dev/null || true)"
     rm -f "$dir/run.lcmlog"
     [[ -n $sim_log && -f $sim_log ]] && rm -f "$sim_log"
   fi

@@ -21,11 +21,6 @@ set -euo pipefail
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
-usage() {
-  sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
-  exit "${1:-2}"
-}
-
 what="" starts=8 members=""
 while (($#)); do
   case "$1" in

@@ -2,7 +2,6 @@
 // first host's launcher also records every channel (lcm-logger), judges the run (traverse-monitor)
 // and replays the input log standing in for the drivers; another host's launcher only runs its
 // own processes until it is stopped. Deaths are handled by the deployment's policy.
-#include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +14,7 @@
 #include "channels.hpp"
 #include "control.hpp"
 #include "launch_report.hpp"
+#include "process.hpp"
 #include "restart_policy.hpp"
 #include "run_checks.hpp"
 #include "run_modes.hpp"
@@ -23,9 +23,6 @@ namespace fs = std::filesystem;
 
 namespace traverse::launch {
 namespace {
-
-std::atomic<bool> g_interrupted{false};
-void on_signal(int) { g_interrupted = true; }
 
 fs::path g_out_dir;      // OUTDIR: control requests arrive there
 fs::path g_status_path;  // OUTDIR/processes.json
@@ -58,7 +55,7 @@ void tick(Supervisor& sup, RestartPolicy& policy) {
   }
 }
 
-bool stopping(const RestartPolicy& policy) { return g_interrupted || policy.stop_graph(); }
+bool stopping(const RestartPolicy& policy) { return stop_requested() || policy.stop_graph(); }
 
 // Waits while `more()` and the graph is not stopping, ticking every 50 ms, at most `timeout_s`.
 template <class F>
@@ -100,17 +97,6 @@ std::set<std::string> wait_until_ready(const std::string& url, std::set<std::str
 }
 
 }  // namespace
-
-bool interrupted() { return g_interrupted; }
-
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  signal(SIGPIPE, SIG_IGN);
-}
 
 void announce(const std::vector<const Child*>& ended) {
   for (const auto* c : ended) {
@@ -208,7 +194,7 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
   }
   report.replay_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - replay_start).count();
-  report.interrupted = g_interrupted;
+  report.interrupted = stop_requested();
 
   // Shut down: playback, then (after a grace period) the graph, the monitor, the logger last so
   // that it records everyone's final status.
@@ -230,7 +216,7 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
   }
   write_status(sup);
   report.duration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (plan.records && !g_interrupted) {
+  if (plan.records && !stop_requested()) {
     for (auto& p : monitor_problems((out_dir / "monitor.json").string())) {
       report.verdict_problems.push_back(std::move(p));
     }

@@ -9,6 +9,7 @@
 // run_checks.hpp), 1 when a process died or had to be killed, 2 for bad arguments, 3 when the
 // verdict fails, 130 when interrupted. Offline, the monitor judges the recorded run afterwards
 // (--replay).
+#include <signal.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +20,7 @@
 #include "config.hpp"
 #include "control.hpp"
 #include "deployment.hpp"
+#include "process.hpp"
 #include "run_modes.hpp"
 #include "version.hpp"
 
@@ -199,7 +201,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "run-graph: cannot create %s\n", o.out.c_str());
     return 1;
   }
-  traverse::launch::install_signal_handlers();
+  traverse::install_stop_signals();  // SIGINT, SIGTERM: stop the graph (stop_requested)
+  signal(SIGPIPE, SIG_IGN);
   const fs::path monitor_config = fs::path(o.root) / "configs" / "monitor.yaml";
   plan.monitor_argv = {monitor, "--name", "monitor", "--out",
                        (fs::absolute(o.out) / "monitor.json").string()};

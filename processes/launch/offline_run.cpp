@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "launch_report.hpp"
+#include "process.hpp"
 #include "run_checks.hpp"
 #include "run_modes.hpp"
 
@@ -37,11 +38,11 @@ int run_offline(const Options& o, const Plan& plan, const fs::path& out_dir) {
       break;
     }
     names.push_back(name);
-    while (sup.find(name)->running && !interrupted()) {
+    while (sup.find(name)->running && !stop_requested()) {
       announce(sup.reap());
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
-    if (interrupted()) break;
+    if (stop_requested()) break;
     if (sup.find(name)->died()) {
       ok = false;
       break;
@@ -51,22 +52,22 @@ int run_offline(const Options& o, const Plan& plan, const fs::path& out_dir) {
   }
   sup.stop(names, o.stop_timeout_s);
   std::error_code ec;
-  if (ok && !interrupted() && input != fs::absolute(o.log)) {
+  if (ok && !stop_requested() && input != fs::absolute(o.log)) {
     fs::rename(input, out_dir / "run.lcmlog", ec);
-  } else if (ok && !interrupted()) {
+  } else if (ok && !stop_requested()) {
     fs::copy_file(input, out_dir / "run.lcmlog", fs::copy_options::overwrite_existing, ec);
   }
   RunReport report;
   report.url = "offline";
   report.out_dir = out_dir.string();
   report.verdict_problems = input_log_problems(o.log);
-  if (ok && !interrupted() && !ec) {
+  if (ok && !stop_requested() && !ec) {
     // The monitor judges the recorded run: what each stage reported in its statuses.
     std::vector<std::string> argv = monitor_argv;
     argv.insert(argv.end(), {"--replay", (out_dir / "run.lcmlog").string()});
     std::fprintf(stderr, "run-graph: the monitor judges %s\n", (out_dir / "run.lcmlog").c_str());
     if (sup.spawn("monitor", argv, (out_dir / "monitor.log").string(), error)) {
-      while (sup.find("monitor")->running && !interrupted()) {
+      while (sup.find("monitor")->running && !stop_requested()) {
         sup.reap();
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
       }
@@ -76,7 +77,7 @@ int run_offline(const Options& o, const Plan& plan, const fs::path& out_dir) {
       report.verdict_problems.push_back(std::move(p));
     }
   }
-  report.interrupted = interrupted();
+  report.interrupted = stop_requested();
   report.duration_s = report.replay_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   int rc = finish_report(report, sup, ok);

@@ -40,10 +40,6 @@ struct Plan {
   double stop_timeout_s = 5.0;  // [s] the longest any stage may need to stop
 };
 
-// SIGINT or SIGTERM reached the launcher.
-bool interrupted();
-void install_signal_handlers();
-
 // Says at once when a child ends on its own with a failure.
 void announce(const std::vector<const Child*>& ended);
 
