@@ -1,13 +1,17 @@
 #include "products.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <limits>
+#include <string>
 
+#include "annotator.hpp"
+#include "bounds.hpp"
 #include "channels.hpp"
 #include "lcm_log.hpp"
+#include "levels.hpp"
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -121,18 +125,19 @@ DensePose transformed(const DensePose& p, const Pose2& T_out_map) {
 }
 
 double bound95_m(const Eigen::Matrix3d& covariance) {
-  const Eigen::Matrix2d c = covariance.topLeftCorner<2, 2>();
+  // The lower triangle (a covariance rotated into another frame may be asymmetric by rounding).
+  const Eigen::Matrix2d c = covariance.topLeftCorner<2, 2>().selfadjointView<Eigen::Lower>();
   if (!c.allFinite()) return std::numeric_limits<double>::infinity();
-  const double lambda = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c).eigenvalues().maxCoeff();
-  return 2.0 * std::sqrt(std::max(lambda, 0.0));
+  return annotator::bound_95(c, annotator::BoundMethod::kPaper);
 }
 
 int loa_level(double bound) {
-  if (bound <= 0.001) return 50;
-  if (bound <= 0.005) return 40;
-  if (bound <= 0.015) return 30;
-  if (bound <= 0.050) return 20;
-  return 10;
+  // The annotator's default legend is the USIBD LOA: levels named LOA50 (best) .. LOA10.
+  static const annotator::Legend legend = [] {
+    const annotator::AnnotatorConfig c;
+    return annotator::Legend(c.standard, c.levels, c.limits_m, c.best_level, c.worst_level);
+  }();
+  return std::stoi(legend.levels()[legend.level_of(bound)].name.substr(3));
 }
 
 std::array<uint8_t, 3> level_colour(int level, int top_level, int bottom_level) {

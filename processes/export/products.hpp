@@ -70,10 +70,12 @@ std::optional<Pose2> world_from_map(const RunEstimate& run, const std::vector<De
 // Applies T_out_map to a pose and its covariance (rotated into the new frame).
 DensePose transformed(const DensePose& p, const Pose2& T_out_map);
 
-// [m] 2 sqrt(largest eigenvalue) of the position block: the 95 % bound of seed 004.
+// [m] 2 sqrt(largest eigenvalue) of the position block: the 95 % bound of seed 004 (the
+// annotator's bound_95 with its paper method); infinite for a non-finite covariance.
 double bound95_m(const Eigen::Matrix3d& covariance);
 
-// USIBD Level of Accuracy (10, 20, 30, 40, 50) of a 95 % bound.
+// USIBD Level of Accuracy (10, 20, 30, 40, 50) of a 95 % bound: the level the annotator's default
+// legend puts it in.
 int loa_level(double bound95_m);
 
 // Colour of a level for a user's top and bottom levels (seed 004): the top level and better are

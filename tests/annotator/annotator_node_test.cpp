@@ -9,8 +9,7 @@
 #include <map>
 
 #include "backend_node.hpp"
-#include "scan_message.hpp"
-#include "synthetic.hpp"
+#include "drive_feed.hpp"
 #include "traverse/key_poses_t.hpp"
 
 namespace traverse::annotator {
@@ -37,18 +36,7 @@ class AnnotatorNodeTest : public ::testing::Test {
         true);
     const backend::test::Drive d = backend::test::drive_ellipse(18.0);
     for (std::size_t k = 0; k < d.utimes.size(); ++k) {
-      planar_scan_t scan =
-          to_planar_scan_message(d.scans[k], "laser_horizontal", static_cast<int64_t>(k));
-      bus_.publish(channels::kScanHorizontal, scan);
-      pose2d_t p{};
-      p.utime = d.utimes[k];
-      p.seq = static_cast<int64_t>(k);
-      p.parent_frame = "map";
-      p.child_frame = "base";
-      p.x = d.input[k].x();
-      p.y = d.input[k].y();
-      p.theta = d.input[k].theta();
-      bus_.publish(channels::kPoseFrontend, p);
+      backend::test::publish_drive_step(bus_, d, k);
       handle_all();
     }
     backend.finish();

@@ -4,27 +4,11 @@
 
 #include <map>
 
-#include "synthetic.hpp"
+#include "drive_feed.hpp"
 #include "traverse/key_poses_t.hpp"
 
 namespace traverse::backend {
 namespace {
-
-planar_scan_t to_message(const PlanarScan& s, int64_t seq) {
-  planar_scan_t m{};
-  m.utime = s.utime_first;
-  m.seq = seq;
-  m.frame = "laser_horizontal";
-  m.utime_first = s.utime_first;
-  m.utime_last = s.utime_last;
-  m.angle_first = static_cast<float>(s.angle_first);
-  m.angle_step = static_cast<float>(s.angle_step);
-  m.range_min = static_cast<float>(s.range_min);
-  m.range_max = static_cast<float>(s.range_max);
-  m.ranges = s.ranges;
-  m.n_ranges = static_cast<int32_t>(s.ranges.size());
-  return m;
-}
 
 class BackendNodeTest : public ::testing::Test {
  protected:
@@ -38,17 +22,7 @@ class BackendNodeTest : public ::testing::Test {
                              [this](const pose2d_t& m) { trajectory_.push_back(m); });
     const test::Drive d = test::drive_ellipse(duration_s);
     for (std::size_t k = 0; k < d.utimes.size(); ++k) {
-      planar_scan_t scan = to_message(d.scans[k], static_cast<int64_t>(k));
-      bus_.publish(channels::kScanHorizontal, scan);
-      pose2d_t p{};
-      p.utime = d.utimes[k];
-      p.seq = static_cast<int64_t>(k);
-      p.parent_frame = "map";
-      p.child_frame = "base";
-      p.x = d.input[k].x();
-      p.y = d.input[k].y();
-      p.theta = d.input[k].theta();
-      bus_.publish(channels::kPoseFrontend, p);
+      test::publish_drive_step(bus_, d, k);
       handle_all();
     }
     node.finish();
