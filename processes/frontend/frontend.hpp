@@ -26,13 +26,11 @@ namespace traverse::frontend {
 
 using Scan = PlanarScan;
 
-// One wheel-odometry message (traverse::odometry_t without its transport fields).
+// One wheel-odometry message: what the motion prior uses of a traverse::odometry_t.
 struct OdometrySample {
   int64_t utime = 0;  // [us] time of the encoder reading
   Pose2 T_odom_base;  // in the odometry's drifting frame: only differences mean anything
   Eigen::Matrix3d pose_covariance = Eigen::Matrix3d::Zero();  // (x [m], y [m], theta [rad]), odom
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // (forward [m/s], left [m/s], turn [rad/s])
-  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();  // [m^2/s^2, m rad/s^2, rad^2/s^2]
 };
 
 enum class ScanStatus {

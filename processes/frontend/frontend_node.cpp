@@ -30,11 +30,7 @@ void FrontendNode::on_odometry(const odometry_t& msg) {
   OdometrySample o;
   o.utime = msg.utime;
   o.T_odom_base = Pose2(msg.x, msg.y, msg.theta);
-  for (int i = 0; i < 9; ++i) {
-    o.pose_covariance(i / 3, i % 3) = msg.pose_covariance[i];
-    o.velocity_covariance(i / 3, i % 3) = msg.velocity_covariance[i];
-  }
-  o.velocity = Eigen::Vector3d(msg.velocity[0], msg.velocity[1], msg.velocity[2]);
+  for (int i = 0; i < 9; ++i) o.pose_covariance(i / 3, i % 3) = msg.pose_covariance[i];
   if (frontend_->add_odometry(o)) last_odometry_utime_ = msg.utime;
   flush();
 }

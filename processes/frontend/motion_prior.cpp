@@ -9,12 +9,6 @@ namespace {
 // Odometry samples older than this (before the newest) are dropped.
 constexpr int64_t kKeepUs = 10'000'000;
 
-Eigen::Matrix3d rotated(const Eigen::Matrix3d& covariance, double theta) {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = Pose2(0.0, 0.0, theta).rotation();
-  return R * covariance * R.transpose();
-}
-
 }  // namespace
 
 MotionPrior::MotionPrior(const MotionPriorConfig& config) : config_(config) {}
@@ -77,7 +71,8 @@ std::optional<OdometryStep> MotionPrior::odometry_step(int64_t t0, int64_t t1,
   step.extrapolated = b->extrapolated;
   // The messages' covariance grows along the path in the odometry frame: its growth over the
   // step, turned into the base frame at t0 (negative parts, a source resetting it, are dropped).
-  Eigen::Matrix3d growth = rotated(b->covariance - a->covariance, -a->T_odom_base.theta());
+  Eigen::Matrix3d growth = rotate_covariance(b->covariance - a->covariance,
+                                             Pose2(0.0, 0.0, -a->T_odom_base.theta()).rotation());
   for (int i = 0; i < 3; ++i) growth(i, i) = std::max(0.0, growth(i, i));
   const double d = step.T_base0_base1.translation().norm();
   const double turn = std::abs(step.T_base0_base1.theta());

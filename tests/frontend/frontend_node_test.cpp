@@ -4,26 +4,12 @@
 
 #include <map>
 
+#include "scan_message.hpp"
 #include "synthetic_scans.hpp"
 #include "traverse/pose2d_t.hpp"
 
 namespace traverse::frontend {
 namespace {
-
-planar_scan_t to_message(const Scan& scan) {
-  planar_scan_t msg{};
-  msg.utime = scan.utime_first;
-  msg.frame = "laser_horizontal";
-  msg.utime_first = scan.utime_first;
-  msg.utime_last = scan.utime_last;
-  msg.angle_first = static_cast<float>(scan.angle_first);
-  msg.angle_step = static_cast<float>(scan.angle_step);
-  msg.range_min = static_cast<float>(scan.range_min);
-  msg.range_max = static_cast<float>(scan.range_max);
-  msg.ranges = scan.ranges;
-  msg.n_ranges = static_cast<int32_t>(scan.ranges.size());
-  return msg;
-}
 
 imu_t imu_at(int64_t utime) {
   imu_t m{};
@@ -50,8 +36,10 @@ class FrontendNodeTest : public ::testing::Test {
     spec.n_ranges = 900;
     spec.angle_step = 300.0 * M_PI / 180.0 / 899.0;
     spec.utime_first = 1'000'000 + k * 20964;
-    return to_message(synthetic::make_sweep(
-        synthetic::room(), [](int64_t) { return Pose2(); }, Pose2(), spec));
+    return to_planar_scan_message(
+        synthetic::make_sweep(
+            synthetic::room(), [](int64_t) { return Pose2(); }, Pose2(), spec),
+        "laser_horizontal");
   }
 
   Bus bus_{"memq://"};
@@ -98,8 +86,10 @@ TEST_F(FrontendNodeTest, LogSubsampledByTravelIsPublishedOneScanLateAndTheLastAt
     spec.angle_step = 300.0 * M_PI / 180.0 / 899.0;
     spec.utime_first = 1'000'000 + k * 1'000'000LL;
     const Pose2 T(-1.5 + 0.3 * k, 0.0, 0.0);
-    auto m = to_message(synthetic::make_sweep(
-        synthetic::room(), [&](int64_t) { return T; }, Pose2(), spec));
+    auto m =
+        to_planar_scan_message(synthetic::make_sweep(
+                                   synthetic::room(), [&](int64_t) { return T; }, Pose2(), spec),
+                               "laser_horizontal");
     utimes.push_back(m.utime_last);
     bus_.publish("TEST_SCAN", m);
   }

@@ -127,9 +127,7 @@ Measurement HectorFrontend::measure(const Scan& scan) {
     if (with.odometry && !r.sparse && config_.motion_prior.odometry_check_margin > 0.0) {
       const MotionModel::Prediction without =
           motion_.predict(scan.utime_last, use_imu, r.sparse, false);
-      const Pose2 d_pred = between(with.T_map_base, without.T_map_base);
-      if (d_pred.translation().norm() > config_.map.resolution_m ||
-          std::abs(d_pred.theta()) > 0.01) {
+      if (differ(with.T_map_base, without.T_map_base)) {
         Attempt other = match_from(m, without);
         if (better(other, attempt, config_.motion_prior.odometry_check_margin) &&
             apart(other, attempt, config_.motion_prior.odometry_check_sigmas)) {
@@ -170,8 +168,7 @@ HectorFrontend::Attempt HectorFrontend::match_from(const Measurement& m,
   // Should the prediction fail, the recovery also searches around the last pose (no motion),
   // unless odometry gave the step.
   std::vector<Pose2> other_centres;
-  if (!p.odometry && (between(T_pred, T_last).translation().norm() > config_.map.resolution_m ||
-                      std::abs(between(T_pred, T_last).theta()) > 0.01)) {
+  if (!p.odometry && differ(T_pred, T_last)) {
     other_centres.push_back(T_last);
   }
   const MatcherConfig matcher = search_windows(p);
@@ -184,6 +181,11 @@ HectorFrontend::Attempt HectorFrontend::match_from(const Measurement& m,
                    : match_scan(map_, m.points_matched, T_pred, matcher, -1, 0, other_centres);
   a.unverified = !sparse && unverified(a.match, T_pred, config_.matcher);
   return a;
+}
+
+bool HectorFrontend::differ(const Pose2& a, const Pose2& b) const {
+  const Pose2 d = between(a, b);
+  return d.translation().norm() > config_.map.resolution_m || std::abs(d.theta()) > 0.01;
 }
 
 bool HectorFrontend::better(const Attempt& a, const Attempt& b, double margin) {

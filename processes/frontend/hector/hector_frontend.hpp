@@ -94,6 +94,8 @@ class HectorFrontend final : public TwoPhaseFrontend {
     bool unverified = false;
   };
   Attempt match_from(const Measurement& m, const MotionModel::Prediction& prediction) const;
+  // a and b lie more than a map cell or 0.01 rad apart (worth matching from both).
+  bool differ(const Pose2& a, const Pose2& b) const;
   // a fits better than b: verified where b is not, else a residual lower by more than margin.
   static bool better(const Attempt& a, const Attempt& b, double margin);
   // a's pose lies more than `sigmas` standard deviations of b's covariance from b's.

@@ -30,17 +30,18 @@ void MotionModel::add_pose(int64_t utime, const Pose2& T_map_base,
                            const Eigen::Matrix3d& covariance, bool sparse) {
   State& s = state_;
   if (s.initialised) {
-    const double dt = 1e-6 * static_cast<double>(utime - s.last_utime);
-    const Eigen::Vector3d v = between(s.T_map_base_last, T_map_base).log() / dt;
+    const int64_t interval_us = utime - s.last_utime;
+    const Eigen::Vector3d step = between(s.T_map_base_last, T_map_base).log();
+    const double dt = 1e-6 * static_cast<double>(interval_us);
+    const Eigen::Vector3d v = step / dt;
     const double alpha = std::min(1.0, dt / kVelocitySmoothingS);
     s.velocity = alpha * v + (1.0 - alpha) * s.velocity;
-    s.last_interval_us = utime - s.last_utime;
+    s.last_interval_us = interval_us;
     if (sparse) {
-      const Eigen::Vector3d step = between(s.T_map_base_last, T_map_base).log();
       constexpr double a = kSparseStepSmoothing;
       s.sparse_step = s.sparse_step ? Eigen::Vector3d(a * step + (1.0 - a) * *s.sparse_step) : step;
     }
-    s.recent_intervals_us.add(static_cast<double>(utime - s.last_utime));
+    s.recent_intervals_us.add(static_cast<double>(interval_us));
   }
   s.T_map_base_last = T_map_base;
   s.last_utime = utime;

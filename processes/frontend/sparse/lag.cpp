@@ -72,7 +72,7 @@ FrontendResult SparseLag::settle(Held held, Measurement* next) {
     // pass): the pose halfway between the steps around it is a second candidate, matched in a
     // narrow window, and the better of the two by the lag's score is kept.
     const Pose2& T_next = next->result.T_map_base;
-    const Pose2 mid = held.T_before * Pose2::exp(0.5 * between(held.T_before, T_next).log());
+    const Pose2 mid = interpolate(held.T_before, T_next, 0.5);
     const Pose2 d = between(mid, k.result.T_map_base);
     if (d.translation().norm() > config_.sparse_lag_window_m ||
         std::abs(d.theta()) > config_.sparse_lag_window_rad) {
