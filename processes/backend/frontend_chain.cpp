@@ -7,13 +7,6 @@
 namespace traverse::backend {
 namespace {
 
-// Rotates the (x, y) part of a covariance by theta.
-Eigen::Matrix3d rotated(const Eigen::Matrix3d& C, double theta) {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  R.topLeftCorner<2, 2>() = Pose2(0.0, 0.0, theta).rotation();
-  return R * C * R.transpose();
-}
-
 // Below this travel a step still drifts as much as this [m]: a standstill keeps a finite
 // information.
 constexpr double kMinDriftTravelM = 0.01;
@@ -25,7 +18,8 @@ Eigen::Matrix3d frontend_pose_covariance(const PreparedPose& pose, double scale,
   const Eigen::Matrix3d& C = pose.frontend.covariance;
   if (C.isZero() || !C.allFinite() || !(C.diagonal().array() > 0.0).all()) return fallback;
   // Map frame -> world (prepared) frame -> the pose's own frame.
-  return scale * rotated(C, -pose.frontend.T_map_base.theta());
+  return scale *
+         rotate_covariance(C, Pose2(0.0, 0.0, -pose.frontend.T_map_base.theta()).rotation());
 }
 
 Edge drift_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
@@ -50,8 +44,8 @@ Edge motion_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
   // edge error's Jacobians (pose_graph.hpp), the covariances turned back into the world frame.
   Eigen::Matrix3d J_a, J_b;
   edge_jacobians(a.T_world_base, b.T_world_base, edge.T_from_to, J_a, J_b);
-  const Eigen::Matrix3d Ca = rotated(ca, a.T_world_base.theta());
-  const Eigen::Matrix3d Cb = rotated(cb, b.T_world_base.theta());
+  const Eigen::Matrix3d Ca = rotate_covariance(ca, a.T_world_base.rotation());
+  const Eigen::Matrix3d Cb = rotate_covariance(cb, b.T_world_base.rotation());
   edge.information = (J_a * Ca * J_a.transpose() + J_b * Cb * J_b.transpose()).inverse();
   return edge;
 }
