@@ -58,7 +58,7 @@ int send_frontend_control(const std::filesystem::path& out_dir, const std::strin
       bus.publish(channels::kFrontendControl, m);
       next_send += std::chrono::milliseconds(200);
     }
-    bus.lcm().handleTimeout(50);
+    bus.handle(50);
   }
   if (!done()) {
     if (!heard) {
