@@ -182,13 +182,19 @@ bool MapperNode::export_all(std::string* error) {
   std::error_code ec;
   std::filesystem::create_directories(config_.output_dir, ec);
   const std::filesystem::path dir(config_.output_dir);
-  if (!write_ply((dir / "cloud.ply").string(), mapper_, &colours_)) {
+  // Each file is written aside and renamed over the old one when complete: a mapper killed while
+  // it exports leaves the files of the last export whole, never a truncated one.
+  const auto replace = [&](const std::string& name) {
+    std::filesystem::rename(dir / (name + ".tmp"), dir / name, ec);
+    return !ec;
+  };
+  if (!write_ply((dir / "cloud.ply.tmp").string(), mapper_, &colours_) || !replace("cloud.ply")) {
     if (error) *error = "cannot write " + (dir / "cloud.ply").string();
     return false;
   }
   mapper_.finish_octree_for_export();
-  if (!mapper_.octree().writeBinaryConst((dir / "map.bt").string()) ||
-      !mapper_.octree().write((dir / "map.ot").string())) {
+  if (!mapper_.octree().writeBinaryConst((dir / "map.bt.tmp").string()) || !replace("map.bt") ||
+      !mapper_.octree().write((dir / "map.ot.tmp").string()) || !replace("map.ot")) {
     if (error) *error = "cannot write the OctoMap into " + dir.string();
     return false;
   }
