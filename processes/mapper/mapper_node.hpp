@@ -24,6 +24,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -33,6 +34,7 @@
 #include "bus.hpp"
 #include "mapper.hpp"
 #include "traverse/annotations_t.hpp"
+#include "traverse/cloud_preview_t.hpp"
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -58,6 +60,9 @@ class MapperNode {
   // worker.
   void finish();
   void report_counters();
+  // Publishes the preview points placed since the last call (cloud_preview_t on preview.channel);
+  // on the thread that handles messages.
+  void publish_preview();
   // The map; read it only after flush() or finish() and before the next message is handled.
   const Mapper& mapper() const { return mapper_; }
 
@@ -82,8 +87,11 @@ class MapperNode {
   void run_worker();
   void stop_worker();  // lets the worker finish what is queued, then joins it
 
+  Bus& bus_;
   MapperConfig config_;
-  Mapper mapper_;  // touched only by the worker (or inline)
+  Mapper mapper_;                          // touched only by the worker (or inline)
+  std::unique_ptr<CloudPreview> preview_;  // filled by the worker, published by publish_preview
+  double preview_messages_ = 0;
   CounterSink counters_;
   // Handler side (LCM thread).
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first
