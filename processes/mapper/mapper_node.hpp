@@ -6,6 +6,9 @@
 // pose2d_t stream (e.g. POSE_GROUND_TRUTH) cut into segments of `poses_per_segment` poses that
 // never move. The annotator's colours (annotations_t on ANNOTATIONS) are kept per key pose, newest
 // first, and given to every point at export (cloud.ply's red, green, blue and level).
+// Out, besides the exports: a decimated preview of every profile placed for the first time
+// (cloud_preview_t on CLOUD_PREVIEW, preview.hpp) for the operator's viewer, published from the
+// process's own thread (publish_preview()).
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a

@@ -23,6 +23,9 @@ void CloudPreview::add(int64_t utime, const Pose2& T_world_base,
   const double c = std::cos(T_world_base.theta()), s = std::sin(T_world_base.theta());
   PreviewProfile out{utime, {}};
   std::lock_guard lock(mutex_);
+  // Neighbouring beams are millimetres apart: most fall in the cell the one before fell in, which
+  // is then known to be taken without asking the set (a lookup per point cost the mapper 20 %).
+  uint64_t previous = ~uint64_t{0};
   for (const Eigen::Vector3f& p : p_world) {
     const double ix = std::floor(p.x() / config_.cell_m) + kHalf;
     const double iy = std::floor(p.y() / config_.cell_m) + kHalf;
@@ -32,6 +35,8 @@ void CloudPreview::add(int64_t utime, const Pose2& T_world_base,
     }
     const uint64_t key = static_cast<uint64_t>(ix) | static_cast<uint64_t>(iy) << 21 |
                          static_cast<uint64_t>(iz) << 42;
+    if (key == previous) continue;
+    previous = key;
     if (!cells_.insert(key).second) continue;
     // Back into the base frame at utime: R^T (p - t), z unchanged (planar pose).
     const double dx = p.x() - T_world_base.x(), dy = p.y() - T_world_base.y();

@@ -105,7 +105,8 @@ void ViewerNode::update(int64_t now_utime) {
   if (scene_.legend() && now) {
     guidance = encode_guidance(
         guide(scene_.annotations(), *scene_.legend(), *now, config_.loop_min_age_s));
-    frames.push_back(*guidance);
+    if (*guidance->data != last_guidance_) frames.push_back(*guidance);  // only when it changed
+    last_guidance_ = *guidance->data;
   }
   server_->broadcast(frames);
   if (server_->snapshot_wanted()) {

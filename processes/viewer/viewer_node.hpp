@@ -54,6 +54,7 @@ class ViewerNode {
   Bus::Handle status_subscription_ = nullptr;
   int64_t last_update_utime_ = 0;
   bool status_changed_ = false;
+  std::string last_guidance_;  // the guidance frame sent last
   double statuses_ = 0, statuses_rejected_ = 0, statuses_stale_ = 0, updates_sent_ = 0,
          update_s_max_ = 0;
 };

@@ -4,7 +4,7 @@
 // its WebGL canvas. Saves a screenshot.
 //
 //   node page_check.mjs --url http://127.0.0.1:PORT/ --screenshot FILE [--timeout S]
-//                       [--min-points N] [--cut-feed] [--watch S]
+//                       [--min-points N] [--cut-feed] [--watch S [--no-draw]]
 //
 // Two pages are opened side by side: the page as served, which must pass, and the same page with
 // its WebSocket cut (answered by a stand-in that never sends anything), which must fail: the check
@@ -12,16 +12,18 @@
 // the real one: the run then fails, as it must. Prints one JSON line last; exits 0 when the
 // served page passed and the cut one failed, 1 otherwise. --watch S only keeps one served page
 // open for S seconds, as an operator would (to measure what a connected browser costs the graph),
-// then prints what it showed.
+// then prints what it showed and the CPU time chromium took [s]; with --no-draw the page is a
+// blank one that only reads the viewer's WebSocket (a browser on another device, as far as this
+// machine is concerned: the viewer does all its work, nothing is drawn here).
 import { chromium } from 'playwright-core';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 
 const args = { timeout: 90, 'min-points': 1000 };
 for (let i = 2; i < process.argv.length; ++i) {
   const key = process.argv[i].replace(/^--/, '');
-  if (key === 'cut-feed') args[key] = true;
+  if (key === 'cut-feed' || key === 'no-draw') args[key] = true;
   else args[key] = process.argv[++i];
 }
 if (!args.url || !args.screenshot) {
@@ -82,15 +84,48 @@ function verdict(v) {
   return null;
 }
 
+// CPU time [s] of every process whose command line names `dir` (chromium's, by its profile).
+function cpuSeconds(dir) {
+  const tick = 100;  // USER_HZ on Linux
+  let total = 0;
+  for (const pid of readdirSync('/proc').filter((p) => /^\d+$/.test(p))) {
+    try {
+      if (!readFileSync(`/proc/${pid}/cmdline`, 'utf8').includes(dir)) continue;
+      const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
+      const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+      total += (Number(fields[11]) + Number(fields[12])) / tick;  // utime, stime
+    } catch {
+      // gone meanwhile
+    }
+  }
+  return Math.round(total * 100) / 100;
+}
+
 async function watch(context, seconds) {
   const page = await context.newPage();
-  await page.goto(args.url);
+  if (args['no-draw']) {
+    await page.goto('about:blank');
+    await page.evaluate((url) => {
+      window.fed = { connected: false, frames: 0, bytes: 0 };
+      const ws = new WebSocket(url.replace(/^http/, 'ws') + 'ws');
+      ws.binaryType = 'arraybuffer';
+      ws.onopen = () => { window.fed.connected = true; };
+      ws.onmessage = (e) => {
+        ++window.fed.frames;
+        window.fed.bytes += typeof e.data === 'string' ? e.data.length : e.data.byteLength;
+      };
+    }, args.url);
+  } else {
+    await page.goto(args.url);
+  }
   await new Promise((r) => setTimeout(r, seconds * 1000));
   const shown = await page.evaluate(() => {
+    if (window.fed) return window.fed;
     const s = window.viewerState;
     return { connected: s.connected, frames: s.frames, bytes: s.bytes, points: s.points, resets: s.resets };
   });
-  await page.screenshot({ path: args.screenshot });
+  shown.chromium_cpu_s = cpuSeconds(userDataDir);
+  if (!args['no-draw']) await page.screenshot({ path: args.screenshot });
   return shown;
 }
 

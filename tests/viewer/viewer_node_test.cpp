@@ -1,7 +1,7 @@
 // The viewer node on memq://: the mapper's preview, the densifier's segments, the annotator's
 // colours, frontend poses and process statuses reach the scene; malformed messages are counted
 // and dropped; a browser connected to its web server gets the whole scene as a snapshot, then the
-// changes (a loop closure's moved profiles as poses only).
+// changes (a loop closure's moved profiles as poses only, the levels it changed).
 #include "viewer_node.hpp"
 
 #include <gtest/gtest.h>
@@ -209,6 +209,31 @@ TEST_F(ViewerNodeTest, ABrowserGetsTheSceneThenTheChanges) {
     poses = true;
   }
   EXPECT_TRUE(poses);
+  // The annotator republishes what the closure changed: key pose 2 from LOA10 to LOA30. The
+  // browser gets that annotation (the page recolours the points nearest to it in time).
+  annotations_t closure = annotations();
+  closure.reason = annotations_t::REASON_LOOP_CLOSURE;
+  closure.keys.resize(1);
+  closure.keys[0] = a.keys[2];
+  closure.keys[0].level = 0;
+  closure.n_keys = 1;
+  pub.publish(channels::kAnnotations, closure);
+  handle_all();
+  node.update(now_utime() + 2'000'000);
+  bool recoloured = false;
+  for (int i = 0; i < 5 && !recoloured; ++i) {
+    ws.read(b);
+    const std::string data = beast::buffers_to_string(b.data());
+    b.consume(b.size());
+    if (ws.got_binary()) continue;
+    const nlohmann::json j = nlohmann::json::parse(data);
+    if (j.at("type") != "annotations") continue;
+    ASSERT_EQ(j.at("keys").size(), 1u);
+    EXPECT_EQ(j.at("keys")[0][0], 2);  // id
+    EXPECT_EQ(j.at("keys")[0][4], 0);  // level
+    recoloured = true;
+  }
+  EXPECT_TRUE(recoloured);
   std::filesystem::remove_all(root);
 }
 

@@ -141,11 +141,9 @@ TEST_F(WebServerTest, ABrowserThatDoesNotReadIsDroppedNotWaitedFor) {
   EXPECT_GT(c.frames_dropped, 0);
   EXPECT_GT(c.bytes_dropped, 0);
   EXPECT_LE(c.queued_bytes_max, kQueue);
-  // Reading again, it gets what was in flight, then is owed a snapshot and gets it.
+  // Reading again, it gets what was in flight (the overflow may have dropped the first snapshot
+  // too, if it was still queued), then is owed a snapshot and gets it.
   beast::flat_buffer b;
-  ws.read(b);
-  EXPECT_EQ(beast::buffers_to_string(b.data()), "reset");
-  b.consume(b.size());
   std::atomic<bool> snapshot_read{false};
   std::thread reader([&] {
     beast::error_code ec;
@@ -159,7 +157,10 @@ TEST_F(WebServerTest, ABrowserThatDoesNotReadIsDroppedNotWaitedFor) {
   if (wanted) server->send_snapshot({frame("snapshot")});
   EXPECT_TRUE(wanted);
   EXPECT_TRUE(eventually([&] { return snapshot_read.load(); }));
-  if (!snapshot_read) ws.next_layer().close();
+  if (!snapshot_read) {
+    beast::error_code ec;
+    ws.next_layer().shutdown(tcp::socket::shutdown_both, ec);  // wakes the reader
+  }
   reader.join();
   EXPECT_EQ(server->counters().snapshots, 2);
 }
