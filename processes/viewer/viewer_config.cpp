@@ -16,7 +16,7 @@ std::optional<std::string> validate(const ViewerConfig& c) {
   check.in_range("update_period_s", c.update_period_s, 0.01, 10.0);
   check.in_range("trajectory_step_m", c.trajectory_step_m, 0.0, 10.0);
   check.in_range("pose_history_s", c.pose_history_s, 1.0, 3600.0);
-  check.not_negative("loop_min_age_s", c.loop_min_age_s);
+  check.in_range("loop_min_age_s", c.loop_min_age_s, 0.0, 86400.0);
   // A snapshot of a large cloud must fit in a queue, or a browser could never catch up.
   check.in_range("client_queue_bytes", c.client_queue_bytes, int64_t{1} << 20, int64_t{1} << 32);
   check.in_range("max_points", c.max_points, 1, 100'000'000);
