@@ -26,6 +26,11 @@ TEST(StatusBoard, RatesCpuRestartsAndStaleness) {
   EXPECT_DOUBLE_EQ(row.out_hz, 50.0);
   EXPECT_DOUBLE_EQ(row.cpu_percent, 25.0);
   EXPECT_FALSE(board.update(report(101, 13, 2.0, 1300)));  // older than the one held
+  // The last status of a stopping process, a millisecond after the one before: rates kept.
+  StatusReport last = report(102, 12, 1.5, 1210);
+  last.utime += 1000;
+  ASSERT_TRUE(board.update(last));
+  EXPECT_DOUBLE_EQ(board.rows().at("frontend").in_hz, 100.0);
   // Restarted (uptime back to 1 s): the counts start again, no negative rate.
   ASSERT_TRUE(board.update(report(103, 1, 0.1, 10)));
   EXPECT_DOUBLE_EQ(board.rows().at("frontend").in_hz, 100.0);
