@@ -11,7 +11,12 @@ namespace traverse::mapper {
 
 MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
                        CounterSink counters, bool worker_thread)
-    : config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
+    : bus_(bus), config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
+  if (!config_.preview.channel.empty()) {
+    preview_ = std::make_unique<CloudPreview>(config_.preview);
+    mapper_.on_first_placement(
+        [p = preview_.get()](int64_t t, const Pose2& T, const auto& pts) { p->add(t, T, pts); });
+  }
   bus.subscribe<planar_scan_t>(channels::kScanProfile,
                                [this](const planar_scan_t& m) { on_profile(m); });
   if (config_.pose_channel.empty()) {
@@ -201,6 +206,30 @@ bool MapperNode::export_all(std::string* error) {
   return true;
 }
 
+void MapperNode::publish_preview() {
+  if (!preview_) return;
+  for (const std::vector<PreviewProfile>& group : preview_->take()) {
+    cloud_preview_t m{};
+    m.parent_frame = "map";
+    m.cell_m = config_.preview.cell_m;
+    for (const PreviewProfile& p : group) {
+      preview_profile_t e{};
+      e.utime = p.utime;
+      e.n_points = static_cast<int32_t>(p.p_base_mm.size());
+      for (const auto& q : p.p_base_mm) {
+        e.x_mm.push_back(q[0]);
+        e.y_mm.push_back(q[1]);
+        e.z_mm.push_back(q[2]);
+      }
+      m.utime = std::max(m.utime, p.utime);
+      m.profiles.push_back(std::move(e));
+    }
+    m.n_profiles = static_cast<int32_t>(m.profiles.size());
+    bus_.publish(config_.preview.channel, m);
+    ++preview_messages_;
+  }
+}
+
 void MapperNode::report_counters() {
   if (!counters_) return;
   Snapshot s;
@@ -231,6 +260,10 @@ void MapperNode::report_counters() {
   counters_("work_queued_max", max_queued);
   counters_("map_lag_s", lag);
   counters_("map_lag_max_s", lag_max);
+  if (preview_) {
+    counters_("preview_points", static_cast<double>(preview_->points()));
+    counters_("preview_messages", preview_messages_);
+  }
 }
 
 }  // namespace traverse::mapper
