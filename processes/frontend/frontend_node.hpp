@@ -47,8 +47,10 @@ class FrontendNode {
   void flush(bool all = false);
   // Copies the frontend's counters to the sink (status counters of the process).
   void report_counters();
-  // Writes the recent window to the state directory (if any).
-  void save_state();
+  // Writes the recent window to the state directory (if any); `durable`: flushed to the disk
+  // before it takes effect (the end of a session; the periodic saves for a crash need not be,
+  // since a killed process loses nothing the kernel already holds).
+  void save_state(bool durable = true);
   const Frontend& frontend() const { return *frontend_; }
   const std::string& kind() const { return kind_; }
   // Resumed from a saved state: scans re-tracked; the first scans' check failed: why (the node
@@ -82,6 +84,9 @@ class FrontendNode {
   double last_misfit_m_ = 0.0, last_misfit_rad_ = 0.0;
   std::string state_dir_;
   int64_t last_saved_utime_ = INT64_MIN;
+  long saves_ = 0;                                // periodic saves of the window
+  double save_total_s_ = 0.0, save_max_s_ = 0.0;  // [s] wall time they took
+  double state_bytes_ = 0.0;                      // [bytes] of the last save
   std::optional<int> resumed_scans_;
   std::optional<Handover> saved_;  // the saved window, while the first scans are checked
   int checks_left_ = 0;
