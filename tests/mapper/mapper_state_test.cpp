@@ -13,6 +13,7 @@
 
 #include "channels.hpp"
 #include "mapper_node.hpp"
+#include "test_profile.hpp"
 
 namespace traverse::mapper {
 namespace {
@@ -51,18 +52,11 @@ struct Feed {
     }
   }
   void profile(int64_t t0) {
-    planar_scan_t s{};
-    s.utime = s.utime_first = t0;
-    s.utime_last = t0 + 30'000;
-    s.frame = "laser_profile";
-    s.angle_first = static_cast<float>(-std::numbers::pi);
-    s.angle_step = static_cast<float>(2 * std::numbers::pi / 360);
-    s.range_min = 0.6f;
-    s.range_max = 6.0f;
-    for (int i = 0; i < 360; ++i) s.ranges.push_back(1.5f + 0.01f * static_cast<float>(i % 50));
-    s.ranges[7] = NAN;
-    s.ranges[8] = 40.0f;  // beyond range_max_m: no point
-    s.n_ranges = 360;
+    std::vector<float> ranges;
+    for (int i = 0; i < 360; ++i) ranges.push_back(1.5f + 0.01f * static_cast<float>(i % 50));
+    ranges[7] = NAN;
+    ranges[8] = 40.0f;  // beyond range_max_m: no point
+    planar_scan_t s = test_profile(t0, std::move(ranges));
     bus.publish(channels::kScanProfile, s);
   }
   // Segment k over [k, k + 1] s, its poses shifted by `dy` [m].
