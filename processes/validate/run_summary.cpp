@@ -24,24 +24,19 @@ void judge(RunSummary& s, const Thresholds& t) {
 }
 
 std::string to_json(const RunSummary& s) {
-  JsonWriter json;
-  json.begin_object();
-  json.field("lcm_url", s.lcm_url);
-  json.field("start_utime", s.start_utime);
-  json.field("end_utime", s.end_utime);
-  json.field("duration_s", 1e-6 * static_cast<double>(s.end_utime - s.start_utime));
-  json.field("events", s.events);
-  json.field("status_decode_failures", s.status_decode_failures);
-  write_channels(json, s.channels);
-  write_processes(json, s.processes);
-  write_problems(json, s.problems);
-  json.key("notes");
-  json.begin_array();
-  for (const auto& n : s.notes) json.value(n);
-  json.end_array();
-  json.field("ok", s.ok);
-  json.end_object();
-  return json.str();
+  Json j;
+  j["lcm_url"] = s.lcm_url;
+  j["start_utime"] = s.start_utime;
+  j["end_utime"] = s.end_utime;
+  j["duration_s"] = json_significant(1e-6 * static_cast<double>(s.end_utime - s.start_utime), 9);
+  j["events"] = s.events;
+  j["status_decode_failures"] = s.status_decode_failures;
+  j["channels"] = channels_json(s.channels);
+  j["processes"] = processes_json(s.processes);
+  j["problems"] = s.problems;
+  j["notes"] = s.notes;
+  j["ok"] = s.ok;
+  return json_line(j);
 }
 
 std::string to_text(const RunSummary& s) {

@@ -15,6 +15,7 @@
 
 #include "deployment.hpp"
 #include "graph_test_util.hpp"
+#include "json.hpp"
 #include "lcm_log.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -132,8 +133,11 @@ Products products(const std::filesystem::path& out) {
   }
   std::ifstream log(out / "evaluator.log");
   for (std::string line; std::getline(log, line);) {
-    const auto at = line.find("\"position_rmse_m\": ");
-    if (at != std::string::npos) p.dense_rmse_m = std::stod(line.substr(at + 19));
+    if (line.empty() || line.front() != '{') continue;  // the evaluator's JSON line
+    const Json j = Json::parse(line, nullptr, false);
+    if (!j.is_discarded() && j.contains("position_rmse_m") && j["position_rmse_m"].is_number()) {
+      p.dense_rmse_m = j["position_rmse_m"].get<double>();
+    }
   }
   std::ifstream ply(out / "mapper" / "cloud.ply");
   for (std::string line; std::getline(ply, line) && line != "end_header";) {
