@@ -66,6 +66,33 @@ TEST(RunGraph, RecordsTheReplayAndEveryStatusOnceASecond) {
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
+// --record-without leaves channels out of run.lcmlog, live (lcm-logger) and offline (the last
+// stage's record copied without them), and nothing else: the graph still hears them.
+TEST(RunGraph, RecordWithoutLeavesTheNamedChannelsOut) {
+  const auto dir = temp_dir("record-without");
+  const std::string log = short_intel_log(dir, kLines);
+  for (const std::string mode : {"live", "offline"}) {
+    const auto out = dir / mode;
+    const auto r = run(run_graph("configs/deploy/pipeline.yaml", log, out) +
+                           " --stages frontend --record-without \"SCAN_.*|ODOMETRY\"" +
+                           (mode == "offline" ? " --offline" : ""),
+                       120);
+    ASSERT_EQ(r.exit_code, 0) << mode << "\n" << r.output;
+    const auto counts = count_channels((out / "run.lcmlog").string());
+    EXPECT_EQ(counts.count("SCAN_HORIZONTAL"), 0u) << mode;
+    EXPECT_EQ(counts.count("ODOMETRY"), 0u) << mode;
+    EXPECT_EQ(counts.count("POSE_REFERENCE") ? counts.at("POSE_REFERENCE") : 0, kScans) << mode;
+    // The frontend heard every scan: one pose each.
+    EXPECT_EQ(counts.count("POSE_FRONTEND") ? counts.at("POSE_FRONTEND") : 0, kScans) << mode;
+    EXPECT_GT(counts.count("STATUS_FRONTEND") ? counts.at("STATUS_FRONTEND") : 0, 0) << mode;
+  }
+  const auto bad = run(
+      run_graph("configs/deploy/pipeline.yaml", log, dir / "bad") + " --record-without \"SCAN_(\"",
+      60);
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
 TEST(RunGraph, TwoRunsAtTheSameTimeDoNotHearEachOther) {
   const auto dir = temp_dir("concurrent");
   const std::string log = short_intel_log(dir, kLines);
