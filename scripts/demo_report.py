@@ -20,8 +20,8 @@ PRODUCTS = [  # (file, what)
     ("reference.tum", "the CARMEN log's reference poses (another SLAM system's), TUM format"),
     ("cloud.ply", "point cloud, PLY (accuracy colour, level)"),
     ("cloud.las", "point cloud, LAS 1.4 (GPS time, intensity, accuracy colour, level)"),
-    ("map.bt", "OctoMap, binary"),
-    ("map.ot", "OctoMap, full"),
+    ("map.bt", "OctoMap, binary (map frame, whatever --frame says: a voxel grid does not turn)"),
+    ("map.ot", "OctoMap, full (map frame)"),
     ("report.md", "accuracy report, Markdown"),
     ("report.json", "accuracy report, every figure"),
     ("trajectory.png", "trajectory plot"),
@@ -122,7 +122,8 @@ def main():
         path = os.path.join(out, name)
         if os.path.exists(path) or name in ("report.md", "report.json"):
             files.append((name, what, path))
-    report = {"what": a.what, "wall_s": a.seconds, "frame": frame, "not_kept": a.removed,
+    report = {"what": a.what, "wall_s": a.seconds, "frame": frame,
+              "frames": {"trajectory": frame, "cloud": frame, "octomap": "map"}, "not_kept": a.removed,
               "evaluation": ev, "export": ex,
               "monitor": {"ok": mon.get("ok"), "problems": mon.get("problems", [])}}
     with open(f"{out}/report.json", "w") as f:
