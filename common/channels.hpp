@@ -22,6 +22,10 @@ inline const std::string kAnnotations =
 inline const std::string kPoseBackend = "POSE_BACKEND";      // pose2d_t, each backend key pose once
 inline const std::string kPoseDense = "POSE_DENSE";          // pose2d_t, corrected dense trajectory
 inline const std::string kDenseSegments = "DENSE_SEGMENTS";  // dense_segments_t, new or moved
+inline const std::string kFrontendControl =
+    "FRONTEND_CONTROL";  // frontend_control_t, which frontend runs (operator's requests)
+inline const std::string kCloudPreview =
+    "CLOUD_PREVIEW";  // cloud_preview_t, the mapper's decimated points for screens
 
 // LCM's udpm provider sends one message here when an instance starts: not part of any run.
 inline const std::string kLcmSelfTest = "LCM_SELF_TEST";

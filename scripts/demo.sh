@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # scripts/demo.sh [ROUTE] [--duration S] [--seed N] [--profile realistic|ideal] [--offline]
 #                 [--carmen FILE] [--thin N] [--frame world|map] [--no-run-log] [--out DIR]
+#                 [--viewer]
 #
 # The whole system on one command: installs what is missing and builds (scripts/setup.sh),
 # simulates the cart on ROUTE (default office-s2, seed 1, the realistic profile; the first
@@ -24,6 +25,10 @@
 #                   sensor channels are not recorded at all; what the graph publishes is (a small
 #                   part of the size), for the evaluation and the export, and removed after them.
 #                   Every other product is written as usual
+#   --viewer        also run traverse-viewer (live runs): open the URL it prints in a browser to
+#                   watch the cloud grow in accuracy colours while the run goes on (the page
+#                   stays with what it showed when the run ends; configs/viewer.yaml sets
+#                   the address and port)
 # Products: trajectory.tum (TUM format: evo and other tools read it), trajectory.csv (with the
 # covariance of every pose), ground_truth.tum, cloud.ply and cloud.las (LAS 1.4: GPS time,
 # intensity, accuracy colour, level), map.bt and map.ot (OctoMap), report.json, report.md with
@@ -49,7 +54,7 @@ mb() {
 }
 
 route=office-s2 duration=180 seed=1 profile=realistic offline="" carmen="" thin=4 frame=""
-keep_log=1 out="$ROOT/out/demo"
+keep_log=1 out="$ROOT/out/demo" viewer=""
 while (($#)); do
   case "$1" in
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
@@ -60,6 +65,7 @@ while (($#)); do
     --thin) thin="${2:?--thin needs a number}"; shift 2 ;;
     --frame) frame="${2:?--frame needs world or map}"; shift 2 ;;
     --no-run-log) keep_log=""; shift ;;
+    --viewer) viewer=1; shift ;;
     --out) out="${2:?--out needs a folder}"; shift 2 ;;
     -h | --help) usage 0 ;;
     -*) echo "demo: unknown option $1" >&2; usage ;;
@@ -72,6 +78,7 @@ done
 [[ -n $frame ]] || frame=map
 [[ $frame == world || $frame == map ]] || die "--frame must be world or map, not '$frame'"
 [[ -z $carmen || $frame == map ]] || die "a CARMEN log has no simulator world: --frame map"
+[[ -z $viewer || -z $offline ]] || die "--viewer shows a live run: not with --offline"
 
 t0=$(date +%s)
 mkdir -p "$out" "$ROOT/out/cache"
@@ -92,7 +99,7 @@ record=()
 [[ -n $keep_log ]] || record=(--record-outputs-only)
 if [[ -n $carmen ]]; then
   carmen="$(cd "$(dirname "$carmen")" && pwd)/$(basename "$carmen")"
-  stages=frontend,backend,densifier
+  stages=frontend,backend,densifier${viewer:+,viewer}
   cmd=("$ROOT/scripts/eval-carmen.sh" "$carmen" --stages "$stages" ${offline:+--offline}
     "${record[@]}" --verdict-warns)
   name="$(basename "$carmen")"
@@ -102,17 +109,23 @@ if [[ -n $carmen ]]; then
   total=""
   input_stage=convert
 else
-  stages=all
+  stages=all${viewer:+,viewer}
   dur=()
   [[ $duration != 0 ]] && dur=(--duration "$duration")
-  cmd=("$ROOT/scripts/eval-route.sh" "$route" --stages all --seed "$seed" --profile "$profile"
+  cmd=("$ROOT/scripts/eval-route.sh" "$route" --stages "$stages" --seed "$seed" --profile "$profile"
     "${dur[@]}" ${offline:+--offline} "${record[@]}" --verdict-warns)
-  run_dir="$ROOT/out/eval/$route-seed$seed${dur:+-d$duration}-$profile-all"
+  run_dir="$ROOT/out/eval/$route-seed$seed${dur:+-d$duration}-$profile-${stages//,/+}"
   what="route $route, seed $seed, $profile profile, $([[ $duration == 0 ]] && echo "whole route" || echo "first $duration s")"
   total="$([[ $duration == 0 ]] || echo "$duration")"
   input_stage=simulate
 fi
 echo "demo: [2/4] $what: $input_stage, run the graph ($([[ -n $offline ]] && echo offline || echo live)), evaluate"
+if [[ -n $viewer ]]; then
+  v_address="$("$PY" "$ROOT/scripts/conf.py" get "$ROOT/configs/viewer.yaml" address 2>/dev/null || echo 127.0.0.1)"
+  v_port="$("$PY" "$ROOT/scripts/conf.py" get "$ROOT/configs/viewer.yaml" port 2>/dev/null || echo 8765)"
+  [[ $v_address == 0.0.0.0 ]] && v_address=localhost
+  echo "demo: the live view: open http://$v_address:$v_port/ in a browser (from when the graph starts until the run ends)"
+fi
 rm -rf "$run_dir"
 mkdir -p "$run_dir"
 "${cmd[@]}" >"$logs/eval.out" 2>"$logs/eval.log" &

@@ -40,7 +40,8 @@ need_programs() {
 # The backend's and densifier's channels carry revisions (key_poses_t, dense_segments_t): the
 # evaluator keeps the newest of each, so the final trajectory is evaluated, not first estimates.
 estimate_channel() {
-  local last="${1##*,}"
+  local list="${1//,viewer/}"  # the viewer publishes no trajectory
+  local last="${list##*,}"
   case "$last" in
     frontend) echo POSE_FRONTEND ;;
     backend | annotator) echo KEY_POSES ;;
@@ -216,7 +217,7 @@ run_and_evaluate() {
 
 # True when the comma-separated stage list runs the mapper.
 runs_mapper() {
-  [[ ,$1, == *,mapper,* || $1 == all ]]
+  [[ ,$1, == *,mapper,* || ,$1, == *,all,* ]]
 }
 
 # cloud_evaluate WORLD_FILE OUTDIR: the mapper's cloud (OUTDIR/mapper/cloud.ply) against the

@@ -10,6 +10,10 @@
 # the others run their processes until stopped (docs/deployment.md). Each process's live state
 # is in OUTDIR/processes.json; a process that dies is handled by its on_death policy. While it
 # runs:  scripts/run-graph.sh --out OUTDIR --control status|start|stop|restart [--process NAME]
+#        scripts/run-graph.sh --out OUTDIR --control frontend --kind icp|hector  (swap frontends)
+# --resume EARLIER_OUT continues the session EARLIER_OUT saved (its state/: the backend's graph,
+# the frontend's last scans) in the new OUTDIR; without it OUTDIR/state/ is cleared
+# (docs/deployment.md, "Crash recovery and sessions").
 #
 # --speed multiplies the log's own pace (default 1; 0 replays as fast as possible, with losses).
 #

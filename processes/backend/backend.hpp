@@ -216,6 +216,7 @@ class Backend {
   int orderings_reused() const { return spa_.system().orderings_reused(); }
 
  private:
+  friend class BackendStateStore;  // backend_state.hpp: saves and restores the members below
   std::optional<BackendUpdate> take_pose(const PreparedPose& pose);
   // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);

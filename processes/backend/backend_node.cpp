@@ -30,12 +30,18 @@ std::optional<std::string> validate(const BackendNodeConfig& c) {
   check.not_negative("publish_move_m", c.publish_move_m);
   check.not_negative("publish_turn_rad", c.publish_turn_rad);
   check.not_negative("publish_covariance_change", c.publish_covariance_change);
+  check.in_range("state_period_s", c.state_period_s, 0.0, 3600.0);
   check.nested("backend", validate(c.backend));
   return check.problem();
 }
 
-BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink counters)
+BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink counters,
+                         const std::string& state_dir)
     : bus_(bus), config_(config), backend_(config.backend), counters_(std::move(counters)) {
+  if (!state_dir.empty()) {
+    state_.emplace(state_dir, std::llround(config_.state_period_s * 1e6), config_.state_durable);
+    resumed_ = state_->resume(backend_);
+  }
   bus_.subscribe<planar_scan_t>(config_.scan_channel,
                                 [this](const planar_scan_t& m) { on_scan(m); });
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
@@ -63,6 +69,7 @@ void BackendNode::on_pose(const pose2d_t& msg) {
 
 void BackendNode::finish() {
   if (auto update = backend_.finish()) publish(*update);
+  if (state_) state_->persist(backend_, true);
 }
 
 bool BackendNode::changed(int i) const {
@@ -200,6 +207,7 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
   }
+  if (state_) state_->persist(backend_);
 }
 
 void BackendNode::report_counters() {
@@ -243,6 +251,14 @@ void BackendNode::report_counters() {
   counters_("scan_bytes_per_key_pose", backend_.scans().bytes_per_key_pose());
   counters_("key_poses_messages", static_cast<double>(messages_));
   counters_("key_poses_message_max_bytes", static_cast<double>(max_message_bytes_));
+  if (!state_) return;
+  const BackendStateCounters& s = state_->counters();
+  counters_("state_snapshots", static_cast<double>(s.snapshots));
+  counters_("state_snapshot_failures", static_cast<double>(s.snapshot_failures));
+  counters_("state_snapshot_last_s", s.last_snapshot_s);
+  counters_("state_snapshot_total_s", s.total_snapshot_s);
+  counters_("state_snapshot_bytes", s.last_snapshot_bytes);
+  counters_("state_key_scans_appended", static_cast<double>(s.key_scans_appended));
 }
 
 }  // namespace traverse::backend

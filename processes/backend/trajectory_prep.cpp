@@ -46,6 +46,14 @@ std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {
   return prepare(held, pose);
 }
 
+void TrajectoryPrep::resume(const PreparedPose& last, const TrajectoryPrepCounters& counters) {
+  counters_ = counters;
+  held_.reset();
+  intervals_us_.clear();
+  last_ = last;
+  smoother_.restart({last.utime, last.frontend.T_map_base}, last.T_world_base);
+}
+
 std::optional<PreparedPose> TrajectoryPrep::finish() {
   if (!held_) return std::nullopt;
   const FrontendPose held = *held_;

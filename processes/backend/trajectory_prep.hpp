@@ -65,6 +65,9 @@ class TrajectoryPrep {
   std::optional<PreparedPose> finish();
 
   const TrajectoryPrepCounters& counters() const { return counters_; }
+  // Goes on after `last` as if it had been the last pose prepared (a backend resumed from its
+  // saved state, backend_state.hpp): the next pose is prepared against it, from its frame.
+  void resume(const PreparedPose& last, const TrajectoryPrepCounters& counters);
 
  private:
   // Whether the poses are taken as a log subsampled by travel (after the newest interval).

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "hector/hector_frontend.hpp"
+#include "icp/icp_frontend.hpp"
 #include "sparse/ensemble.hpp"
 #include "sparse/lag.hpp"
 #include "two_phase.hpp"
@@ -11,6 +12,7 @@
 namespace traverse::frontend {
 
 std::unique_ptr<Frontend> make_frontend(const FrontendConfig& config) {
+  if (config.kind == "icp") return std::make_unique<IcpFrontend>(config);
   // One Hector frontend starting at T_map_base_initial, one scan behind on a log subsampled by
   // travel when the config says so.
   const auto make_member = [config](const Pose2& T_map_base_initial) -> std::unique_ptr<Frontend> {

@@ -96,6 +96,8 @@ std::optional<std::string> validate(const MotionPriorConfig& c) {
 
 std::optional<std::string> validate(const FrontendConfig& c) {
   ConfigCheck check;
+  check.require(c.kind == "hector" || c.kind == "icp", "kind",
+                "must be hector or icp, got '" + c.kind + "'");
   check.not_empty("scan_channel", c.scan_channel);
   check.not_empty("imu_channel", c.imu_channel);
   check.not_empty("odometry_channel", c.odometry_channel);
@@ -106,6 +108,8 @@ std::optional<std::string> validate(const FrontendConfig& c) {
   check.nested("matcher", validate(c.matcher));
   check.nested("deskew", validate(c.deskew));
   check.nested("motion_prior", validate(c.motion_prior));
+  check.nested("icp", validate(c.icp));
+  check.nested("handover", validate(c.handover));
   if (check.problem()) return check.problem();
   // The searches' windows in cells of the level each runs on: the recovery search on the
   // coarsest, the wide search on level 1 (or 0 with one level).

@@ -7,6 +7,8 @@
 #include <string>
 
 #include "channels.hpp"
+#include "handover_config.hpp"
+#include "icp/icp_config.hpp"
 #include "pose_config.hpp"
 
 namespace traverse::frontend {
@@ -262,6 +264,9 @@ struct MotionPriorConfig {
 };
 
 struct FrontendConfig {
+  // Which frontend runs: hector (hector/) or icp (icp/); another can take over while the graph
+  // runs (frontend_node.hpp, handover).
+  std::string kind = "hector";
   std::string scan_channel = channels::kScanHorizontal;
   std::string imu_channel = channels::kImu;
   std::string odometry_channel = channels::kOdometry;
@@ -276,9 +281,12 @@ struct FrontendConfig {
   MatcherConfig matcher;
   DeskewConfig deskew;
   MotionPriorConfig motion_prior;
+  IcpConfig icp;
+  HandoverConfig handover;
 
   template <class V>
   void visit(V& v) {
+    v("kind", kind);
     v("scan_channel", scan_channel);
     v("imu_channel", imu_channel);
     v("odometry_channel", odometry_channel);
@@ -289,6 +297,8 @@ struct FrontendConfig {
     v("matcher", matcher);
     v("deskew", deskew);
     v("motion_prior", motion_prior);
+    v("icp", icp);
+    v("handover", handover);
   }
 };
 

@@ -6,6 +6,15 @@
 // before the IMU samples taken during the sweep; likewise for odometry, once any has come (its
 // messages may trail the scan). A frontend may give a pose a scan late (on a log subsampled by
 // travel: MatcherConfig:: sparse_lag), the last one at shutdown (flush(true)).
+//
+// Handover (handover.hpp): a frontend_control_t on handover.control_channel naming another kind
+// replaces the running frontend between two scans by one of that kind, started from the recent
+// scans and aligned with the last published pose; the status says which kind runs
+// (frontend_kind_icp), how many swaps were made and the last request carried out
+// (frontend_request_id), which is what the sender waits for. With a state directory the recent
+// window is saved (every handover.save_period_s of data and at the end) and a node started on it
+// again resumes from it: a mapping session continued later, or a frontend restarted after a crash.
+// Its first scans are checked against the saved ones (resume_failure() says why not).
 #pragma once
 
 #include <cstdint>
@@ -17,6 +26,8 @@
 
 #include "bus.hpp"
 #include "frontend.hpp"
+#include "handover.hpp"
+#include "traverse/frontend_control_t.hpp"
 #include "traverse/imu_t.hpp"
 #include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
@@ -26,28 +37,56 @@ namespace traverse::frontend {
 class FrontendNode {
  public:
   using CounterSink = std::function<void(const std::string& name, double value)>;
-  FrontendNode(Bus& bus, const FrontendConfig& config, CounterSink counters = {});
+  // With `state_dir`: resumes from the state saved there, if any (throws std::runtime_error when
+  // that state is damaged), and saves its own there.
+  FrontendNode(Bus& bus, const FrontendConfig& config, CounterSink counters = {},
+               const std::string& state_dir = "");
 
   // Processes every scan that is ready; all waiting scans, and the one the lag holds, if `all`
   // (at shutdown).
   void flush(bool all = false);
   // Copies the frontend's counters to the sink (status counters of the process).
   void report_counters();
+  // Writes the recent window to the state directory (if any).
+  void save_state();
   const Frontend& frontend() const { return *frontend_; }
+  const std::string& kind() const { return kind_; }
+  // Resumed from a saved state: scans re-tracked; the first scans' check failed: why (the node
+  // then publishes nothing more).
+  std::optional<int> resumed_scans() const { return resumed_scans_; }
+  const std::string& resume_failure() const { return resume_failure_; }
 
  private:
   void on_scan(const planar_scan_t& msg);
   void on_imu(const imu_t& msg);
   void on_odometry(const odometry_t& msg);
+  void on_control(const frontend_control_t& msg);
   void publish(const FrontendResult& result);
+  // Replaces the frontend by one of `kind` started from the recent window.
+  void hand_over(const std::string& kind);
+  // The resumed session's check of a scan's published pose against the saved scans.
+  bool check_resumed(const Scan& scan, const Pose2& T_map_base);
 
   Bus& bus_;
   FrontendConfig config_;
+  std::string kind_;
   std::unique_ptr<Frontend> frontend_;
   CounterSink counters_;
   std::deque<Scan> pending_;
   std::optional<int64_t> last_imu_utime_;       // [us] of the newest IMU sample the frontend took
   std::optional<int64_t> last_odometry_utime_;  // [us] of the newest odometry sample it took
+  Handover handover_;
+  Pose2 C_;  // published pose = C_ * the frontend's own (identity until a handover)
+  int64_t last_request_id_ = 0;
+  int64_t swaps_ = 0, control_rejected_ = 0;
+  double last_misfit_m_ = 0.0, last_misfit_rad_ = 0.0;
+  std::string state_dir_;
+  int64_t last_saved_utime_ = INT64_MIN;
+  std::optional<int> resumed_scans_;
+  std::optional<Handover> saved_;  // the saved window, while the first scans are checked
+  int checks_left_ = 0;
+  double worst_fit_ = 1.0;
+  std::string resume_failure_;
 };
 
 }  // namespace traverse::frontend

@@ -88,11 +88,15 @@ std::vector<StageSpec> started_here(const Deployment& d, const std::vector<Stage
 
 std::optional<std::vector<StageSpec>> select_stages(const Deployment& d, const std::string& list,
                                                     std::string& error) {
-  if (list.empty() || list == "all") return d.processes;
   std::set<std::string> wanted;
+  bool all = list.empty();
   std::stringstream ss(list);
   for (std::string name; std::getline(ss, name, ',');) {
     if (name.empty()) continue;
+    if (name == "all") {
+      all = true;
+      continue;
+    }
     bool known = false;
     for (const auto& s : d.processes) known = known || s.name == name;
     if (!known) {
@@ -103,7 +107,7 @@ std::optional<std::vector<StageSpec>> select_stages(const Deployment& d, const s
   }
   std::vector<StageSpec> out;
   for (const auto& s : d.processes) {
-    if (wanted.count(s.name)) out.push_back(s);
+    if (wanted.count(s.name) || (all && !s.optional)) out.push_back(s);
   }
   return out;
 }

@@ -9,6 +9,7 @@
 //       host: server                    # optional: one of `hosts` (default: the first host)
 //       on_death: restart               # optional: report (default), restart or stop_graph
 //       max_restarts: 3                 # with restart: then give up (it stays down, reported)
+//       optional: true                  # started only when --stages names it ("all" leaves it)
 //
 // and the launcher gives each one its config, --name and the one LCM URL of the run. A graph on
 // several machines also says
@@ -43,6 +44,8 @@ struct StageSpec {
   std::string on_death = "report";
   int max_restarts = 3;
   double restart_delay_s = 0.5;  // [s] from its death to its restart
+  // Started only when the stage list names it (e.g. the viewer: "all,viewer"); "all" leaves it out.
+  bool optional = false;
 
   template <class V>
   void visit(V& v) {
@@ -55,6 +58,7 @@ struct StageSpec {
     v("on_death", on_death);
     v("max_restarts", max_restarts);
     v("restart_delay_s", restart_delay_s);
+    v("optional", optional);
   }
 };
 
@@ -98,8 +102,8 @@ struct Deployment {
 // Every process's `host` is filled in (the first host when it names none).
 Deployment load_deployment(const std::string& path);
 
-// The stages named in `list` ("all", or names separated by commas) in deployment order;
-// nullopt and `error` set when a name is not in the deployment.
+// The stages named in `list` (names separated by commas; "all" stands for every stage not marked
+// optional) in deployment order; nullopt and `error` set when a name is not in the deployment.
 std::optional<std::vector<StageSpec>> select_stages(const Deployment& d, const std::string& list,
                                                     std::string& error);
 

@@ -158,6 +158,8 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
   done_control_request(out_dir);  // a request left from an earlier run is not for this one
   g_status_path = out_dir / "processes.json";
   write_status(sup);
+  std::ofstream(out_dir / "lcm_url") << o.lcm_url << '\n';  // for --control frontend
+  std::error_code ec_ignored;
   std::fprintf(stderr, "run-graph: LCM URL %s, %zu processes, output in %s\n", o.lcm_url.c_str(),
                plan.stages.size(), out_dir.c_str());
   for (const auto& e : plan.elsewhere) {
@@ -218,6 +220,7 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
     sup.stop({"logger"}, o.stop_timeout_s);
   }
   write_status(sup);
+  fs::remove(out_dir / "lcm_url", ec_ignored);  // nothing listens there any more
   report.duration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (plan.records && !stop_requested()) {
     for (auto& p : monitor_problems((out_dir / "monitor.json").string())) {

@@ -21,8 +21,10 @@
 #include "config.hpp"
 #include "control.hpp"
 #include "deployment.hpp"
+#include "frontend_control.hpp"
 #include "process.hpp"
 #include "run_modes.hpp"
+#include "session.hpp"
 #include "version.hpp"
 
 namespace fs = std::filesystem;
@@ -60,8 +62,14 @@ void add_options(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--control", o.control,
                  "to the launcher running with this --out: start, stop or restart --process NAME, "
-                 "or status (prints OUTDIR/processes.json)");
+                 "status (prints OUTDIR/processes.json), or frontend --kind KIND (swaps the "
+                 "frontend of the running graph)");
   app.add_option("--process", o.process, "with --control: the process");
+  app.add_option("--kind", o.kind, "with --control frontend: hector or icp");
+  app.add_option("--resume", o.resume,
+                 "a session's earlier output folder: its state/ (the processes' saved state) is "
+                 "copied into --out and the processes go on from it; without it --out's state/ "
+                 "is cleared");
   app.add_flag("--offline", o.offline,
                "no bus: run the stages one after another on the log (--replay/--record), as "
                "fast as they compute and without transport loss; --speed is ignored");
@@ -102,6 +110,10 @@ int main(int argc, char** argv) {
   traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
+  if (o.control == "frontend") {
+    return traverse::launch::send_frontend_control(
+        o.out, o.process.empty() ? "frontend" : o.process, o.kind, o.stop_timeout_s + 10.0);
+  }
   if (!o.control.empty()) {
     return traverse::launch::send_control(o.out, o.control, o.process, o.stop_timeout_s + 30.0);
   }
@@ -211,6 +223,10 @@ int main(int argc, char** argv) {
   if (!fs::is_directory(o.out)) {
     std::fprintf(stderr, "run-graph: cannot create %s\n", o.out.c_str());
     return 1;
+  }
+  if (const auto problem = traverse::launch::prepare_state(o.out, o.resume)) {
+    std::fprintf(stderr, "run-graph: %s\n", problem->c_str());
+    return traverse::kConfigErrorExitCode;
   }
   traverse::install_stop_signals();  // SIGINT, SIGTERM: stop the graph (stop_requested)
   signal(SIGPIPE, SIG_IGN);

@@ -49,10 +49,12 @@ int main(int argc, char** argv) {
     }
   };
   const int rc = proc.spin([&] {
+    node.publish_preview();
     node.report_counters();
     if (g_export_requested.exchange(false)) do_export();
   });
   node.finish();
+  node.publish_preview();
   do_export();
   node.report_counters();
   proc.publish_status("stopped");

@@ -32,6 +32,7 @@ std::optional<std::string> validate(const MapperConfig& c) {
   check.in_range("poses_per_segment", c.poses_per_segment, 1, 1'000'000);
   check.positive("max_pending_s", c.max_pending_s);
   check.in_range("move_threads", c.move_threads, 1, 64);
+  check.nested("preview", validate(c.preview));
   return check.problem();
 }
 
@@ -259,6 +260,7 @@ void Mapper::try_pending() {
         tree_->updateNode(unpack(k), true, true);
       }
       s.in_map = true;
+      first_placed(s);
     }
     points_ += s.n_points;
     longest_profile_us_ = std::max(longest_profile_us_, s.utime_last - s.utime_first);
@@ -347,12 +349,14 @@ std::size_t Mapper::apply_moves() {
     for (auto& h : helpers) h.join();
     for (std::size_t i = 0; i < n; ++i) {
       Stored& s = stored_[dirty[b0 + i]];
-      if (s.in_map) ++moved;
+      const bool first = !s.in_map;
+      if (!first) ++moved;
       for (uint64_t k : changes[i].left) remove_hit(k);
       for (uint64_t k : changes[i].entered) add_hit(k);
       s.key_id = trajectory_.segment_at(s.utime_first)->key_id_first;
       s.dirty = false;
       s.in_map = true;
+      if (first) first_placed(s);
     }
   }
   before_moves_.clear();
@@ -365,6 +369,14 @@ std::size_t Mapper::apply_moves() {
   touched_.clear();
   profiles_replaced_ += static_cast<int64_t>(moved);
   return moved;
+}
+
+void Mapper::first_placed(const Stored& s) const {
+  if (!first_placement_) return;
+  thread_local std::vector<Eigen::Vector3f> pts;
+  thread_local std::vector<int> beams;
+  const std::optional<Pose2> T_world_base = trajectory_.pose_at(s.utime_first);
+  if (T_world_base && place(s, pts, beams)) first_placement_(s.utime_first, *T_world_base, pts);
 }
 
 std::size_t Mapper::drop_stale(int64_t now_utime) {

@@ -35,6 +35,7 @@
 
 #include "planar_scan.hpp"
 #include "point_colours.hpp"
+#include "preview.hpp"
 #include "trajectory_store.hpp"
 
 namespace traverse::mapper {
@@ -67,6 +68,7 @@ struct MapperConfig {
   int poses_per_segment = 40;                       // segment length when reading a pose2d_t stream
   double max_pending_s = 30.0;  // [s] profiles waiting longer for poses are dropped
   int move_threads = 2;         // threads that place moved profiles again (counts: one thread)
+  PreviewConfig preview;        // decimated points for screens on CLOUD_PREVIEW (preview.hpp)
   template <class V>
   void visit(V& v) {
     v("resolution_m", resolution_m);
@@ -80,6 +82,7 @@ struct MapperConfig {
     v("poses_per_segment", poses_per_segment);
     v("max_pending_s", max_pending_s);
     v("move_threads", move_threads);
+    v("preview", preview);
   }
 };
 
@@ -133,6 +136,13 @@ class Mapper {
   // [bytes] memory held by the stored profiles (not the OctoMap).
   std::size_t profile_bytes() const;
 
+  // Called (on the thread that adds profiles and segments) once for every profile when it first
+  // goes into the map, with its points as placed and the pose T_world_base at its first beam time;
+  // later moves do not call it again. For the screen preview (preview.hpp).
+  using FirstPlacement = std::function<void(int64_t utime_first, const Pose2& T_world_base,
+                                            const std::vector<Eigen::Vector3f>& p_world)>;
+  void on_first_placement(FirstPlacement f) { first_placement_ = std::move(f); }
+
  private:
   struct Stored {
     int64_t utime_first = 0, utime_last = 0;
@@ -173,6 +183,7 @@ class Mapper {
   void add_hit(uint64_t key);
   void remove_hit(uint64_t key);
   void try_pending();
+  void first_placed(const Stored& s) const;
 
   MapperConfig config_;
   Eigen::Isometry3d T_base_laser_;
@@ -190,6 +201,7 @@ class Mapper {
   std::unordered_map<uint64_t, uint32_t> hits_;  // profiles hitting each voxel, by packed key
   std::vector<uint64_t> touched_;  // voxels whose hit count changed since the last apply_moves
   int64_t points_ = 0, points_filtered_ = 0, profiles_replaced_ = 0;
+  FirstPlacement first_placement_;
 };
 
 }  // namespace traverse::mapper

@@ -11,7 +11,12 @@ namespace traverse::mapper {
 
 MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
                        CounterSink counters, bool worker_thread)
-    : config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
+    : bus_(bus), config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
+  if (!config_.preview.channel.empty()) {
+    preview_ = std::make_unique<CloudPreview>(config_.preview);
+    mapper_.on_first_placement(
+        [p = preview_.get()](int64_t t, const Pose2& T, const auto& pts) { p->add(t, T, pts); });
+  }
   bus.subscribe<planar_scan_t>(channels::kScanProfile,
                                [this](const planar_scan_t& m) { on_profile(m); });
   if (config_.pose_channel.empty()) {
@@ -182,17 +187,47 @@ bool MapperNode::export_all(std::string* error) {
   std::error_code ec;
   std::filesystem::create_directories(config_.output_dir, ec);
   const std::filesystem::path dir(config_.output_dir);
-  if (!write_ply((dir / "cloud.ply").string(), mapper_, &colours_)) {
+  // Each file is written aside and renamed over the old one when complete: a mapper killed while
+  // it exports leaves the files of the last export whole, never a truncated one.
+  const auto replace = [&](const std::string& name) {
+    std::filesystem::rename(dir / (name + ".tmp"), dir / name, ec);
+    return !ec;
+  };
+  if (!write_ply((dir / "cloud.ply.tmp").string(), mapper_, &colours_) || !replace("cloud.ply")) {
     if (error) *error = "cannot write " + (dir / "cloud.ply").string();
     return false;
   }
   mapper_.finish_octree_for_export();
-  if (!mapper_.octree().writeBinaryConst((dir / "map.bt").string()) ||
-      !mapper_.octree().write((dir / "map.ot").string())) {
+  if (!mapper_.octree().writeBinaryConst((dir / "map.bt.tmp").string()) || !replace("map.bt") ||
+      !mapper_.octree().write((dir / "map.ot.tmp").string()) || !replace("map.ot")) {
     if (error) *error = "cannot write the OctoMap into " + dir.string();
     return false;
   }
   return true;
+}
+
+void MapperNode::publish_preview() {
+  if (!preview_) return;
+  for (const std::vector<PreviewProfile>& group : preview_->take()) {
+    cloud_preview_t m{};
+    m.parent_frame = "map";
+    m.cell_m = config_.preview.cell_m;
+    for (const PreviewProfile& p : group) {
+      preview_profile_t e{};
+      e.utime = p.utime;
+      e.n_points = static_cast<int32_t>(p.p_base_mm.size());
+      for (const auto& q : p.p_base_mm) {
+        e.x_mm.push_back(q[0]);
+        e.y_mm.push_back(q[1]);
+        e.z_mm.push_back(q[2]);
+      }
+      m.utime = std::max(m.utime, p.utime);
+      m.profiles.push_back(std::move(e));
+    }
+    m.n_profiles = static_cast<int32_t>(m.profiles.size());
+    bus_.publish(config_.preview.channel, m);
+    ++preview_messages_;
+  }
 }
 
 void MapperNode::report_counters() {
@@ -225,6 +260,10 @@ void MapperNode::report_counters() {
   counters_("work_queued_max", max_queued);
   counters_("map_lag_s", lag);
   counters_("map_lag_max_s", lag_max);
+  if (preview_) {
+    counters_("preview_points", static_cast<double>(preview_->points()));
+    counters_("preview_messages", preview_messages_);
+  }
 }
 
 }  // namespace traverse::mapper

@@ -6,6 +6,9 @@
 // pose2d_t stream (e.g. POSE_GROUND_TRUTH) cut into segments of `poses_per_segment` poses that
 // never move. The annotator's colours (annotations_t on ANNOTATIONS) are kept per key pose, newest
 // first, and given to every point at export (cloud.ply's red, green, blue and level).
+// Out, besides the exports: a decimated preview of every profile placed for the first time
+// (cloud_preview_t on CLOUD_PREVIEW, preview.hpp) for the operator's viewer, published from the
+// process's own thread (publish_preview()).
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
@@ -24,6 +27,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -33,6 +37,7 @@
 #include "bus.hpp"
 #include "mapper.hpp"
 #include "traverse/annotations_t.hpp"
+#include "traverse/cloud_preview_t.hpp"
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -58,6 +63,9 @@ class MapperNode {
   // worker.
   void finish();
   void report_counters();
+  // Publishes the preview points placed since the last call (cloud_preview_t on preview.channel);
+  // on the thread that handles messages.
+  void publish_preview();
   // The map; read it only after flush() or finish() and before the next message is handled.
   const Mapper& mapper() const { return mapper_; }
 
@@ -82,8 +90,11 @@ class MapperNode {
   void run_worker();
   void stop_worker();  // lets the worker finish what is queued, then joins it
 
+  Bus& bus_;
   MapperConfig config_;
-  Mapper mapper_;  // touched only by the worker (or inline)
+  Mapper mapper_;                          // touched only by the worker (or inline)
+  std::unique_ptr<CloudPreview> preview_;  // filled by the worker, published by publish_preview
+  double preview_messages_ = 0;
   CounterSink counters_;
   // Handler side (LCM thread).
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first

@@ -9,27 +9,13 @@
 #include <optional>
 #include <string>
 
+#include "status_report.hpp"
+
 namespace traverse::validate {
 
-// One status message in plain terms (the monitor's node converts process_status_t to this).
-struct ProcessReport {
-  std::string process;  // process name
-  std::string host;
-  int32_t pid = 0;
-  int64_t seq = 0;        // +1 per status message
-  std::string state;      // "running", "stopping", free text after a colon
-  double uptime_s = 0;    // [s]
-  double cpu_s = 0;       // [s] user + system CPU time
-  int64_t rss_bytes = 0;  // [bytes]
-  // Sums over the process's channels since it started [messages].
-  int64_t received = 0, published = 0, decode_failures = 0, out_of_order = 0, missed = 0,
-          handler_errors = 0;
-  // From its counters: messages rejected (cannot be right, beyond a limit) and stamps dropped as
-  // far from their neighbours, summed over channels; what its receive queue dropped; for an
-  // offline run, the events it replayed and the damaged records met in its input (-1: live).
-  int64_t rejected = 0, stamp_outliers = 0, queue_dropped = 0;
-  int64_t replay_events = -1, replay_damaged_records = -1;
-};
+// One status message in plain terms (common/status_report.hpp: report_of converts
+// process_status_t to it).
+using ProcessReport = StatusReport;
 
 struct ProcessSummary {
   ProcessReport last;                      // the last status heard

@@ -23,6 +23,7 @@
 #include "monitor_node.hpp"
 #include "simulator.hpp"
 #include "spa.hpp"
+#include "viewer_config.hpp"
 
 namespace traverse::test {
 namespace {
@@ -147,6 +148,13 @@ TEST_F(ConfigWalk, Monitor) {
   WalkCase c = walk("traverse-monitor", "configs/monitor.yaml", {"--lcm-url memq://"});
   c.stop_after_s = 0.5;
   walk_config<MonitorConfig>(c);
+}
+
+TEST_F(ConfigWalk, Viewer) {
+  // The viewer serves until stopped (on a free port here): SIGINT after half a second.
+  WalkCase c = walk("traverse-viewer", "configs/viewer.yaml", {"--lcm-url memq:// --port 0"});
+  c.stop_after_s = 0.5;
+  walk_config<viewer::ViewerConfig>(c);
 }
 
 }  // namespace

@@ -80,6 +80,19 @@ TEST(Frontend, TracksWithoutImu) {
   EXPECT_EQ(run.counters.at("imu_samples"), 0);
 }
 
+// The ICP frontend (icp/) through the same walk: the same messages, the same accuracy.
+TEST(Frontend, IcpKindTracksWalkThroughRoomWithAndWithoutImu) {
+  FrontendConfig config;
+  config.kind = "icp";
+  for (const bool imu : {true, false}) {
+    const RoomRun run = run_room(config, imu, 0.4);
+    EXPECT_LT(run.position_error_m, 0.005) << imu;
+    EXPECT_LT(run.heading_error_rad, 0.001) << imu;
+    EXPECT_GT(run.counters.at("map_updates"), 2);
+    EXPECT_EQ(run.counters.at("scans_unverified"), 0);
+  }
+}
+
 // A scanner's stream is matched by one frontend: the sparse-scan ensemble votes on its first
 // scans only, then is dropped.
 TEST(Frontend, ScannerStreamDropsTheSparseEnsemble) {

@@ -6,6 +6,9 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
 
 #include "lcm_log.hpp"
 #include "traverse/process_status_t.hpp"
@@ -27,6 +30,20 @@ CommandResult run(const std::string& command, int timeout_s) {
 }
 
 std::string bin_dir() { return TRAVERSE_BIN_DIR; }
+
+std::string read_text(const std::filesystem::path& path) {
+  std::stringstream s;
+  s << std::ifstream(path).rdbuf();
+  return s.str();
+}
+
+int running_pid(const std::filesystem::path& processes_json, const std::string& name) {
+  const std::regex entry("\\{\"name\":\"" + name + "\",\"host\":\"[^\"]*\",\"pid\":([0-9]+)," +
+                         "\"running\":true");
+  std::smatch m;
+  const std::string text = read_text(processes_json);
+  return std::regex_search(text, m, entry) ? std::stoi(m[1]) : 0;
+}
 
 std::vector<std::string> traverse_programs() {
   std::vector<std::string> names;

@@ -21,6 +21,11 @@ std::string bin_dir();                                    // TRAVERSE_BIN_DIR
 std::vector<std::string> traverse_programs();             // names of bin/traverse-*, e.g. "carmen"
 std::filesystem::path temp_dir(const std::string& name);  // fresh, under the system temp dir
 
+// The whole text of a file ("" when it cannot be read).
+std::string read_text(const std::filesystem::path& path);
+// The pid a launcher's processes.json gives `name`, 0 when it is not there (yet) or not running.
+int running_pid(const std::filesystem::path& processes_json, const std::string& name);
+
 // Messages per channel in an LCM log; fails the test if the log is damaged.
 std::map<std::string, int64_t> count_channels(const std::string& lcm_log);
 

@@ -55,6 +55,21 @@ TEST(Deployment, LoadsSelectsAndRejects) {
   EXPECT_FALSE(select_stages(d, "a,zzz", error));
   EXPECT_NE(error.find("zzz"), std::string::npos);
 
+  // An optional stage (the viewer) runs only when named: "all" leaves it out, "all,v" adds it.
+  const Deployment with_optional =
+      load_deployment(write(dir, "optional.yaml",
+                            "processes:\n"
+                            "  - {name: a, program: traverse-a}\n"
+                            "  - {name: v, program: traverse-v, optional: true}\n"
+                            "  - {name: c, program: traverse-c}\n"));
+  EXPECT_EQ(select_stages(with_optional, "all", error)->size(), 2u);
+  EXPECT_EQ(select_stages(with_optional, "", error)->size(), 2u);
+  const auto plus = select_stages(with_optional, "all,v", error);
+  ASSERT_TRUE(plus);
+  ASSERT_EQ(plus->size(), 3u);
+  EXPECT_EQ((*plus)[1].name, "v");
+  EXPECT_EQ(select_stages(with_optional, "v", error)->size(), 1u);
+
   expect_refused(dir,
                  {{"processes:\n  - {name: a, program: p, confg: x}\n", "confg"},
                   {"processes:\n  - {name: a, program: p}\n  - {name: a, program: q}\n", "twice"},

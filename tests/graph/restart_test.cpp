@@ -7,9 +7,7 @@
 
 #include <chrono>
 #include <fstream>
-#include <regex>
 #include <set>
-#include <sstream>
 #include <thread>
 
 #include "graph_test_util.hpp"
@@ -18,21 +16,6 @@ namespace traverse::graph_test {
 namespace {
 
 const std::string kLog = "logs/office-s2_seed1_20s-22s_profile-every-5th.lcmlog";
-
-std::string read(const std::filesystem::path& path) {
-  std::stringstream s;
-  s << std::ifstream(path).rdbuf();
-  return s.str();
-}
-
-// The pid processes.json gives `name`, 0 when it is not there (yet) or not running.
-int pid_of(const std::filesystem::path& processes_json, const std::string& name) {
-  const std::regex entry("\\{\"name\":\"" + name + "\",\"host\":\"[^\"]*\",\"pid\":([0-9]+)," +
-                         "\"running\":true");
-  std::smatch m;
-  const std::string text = read(processes_json);
-  return std::regex_search(text, m, entry) ? std::stoi(m[1]) : 0;
-}
 
 std::string launch(const std::string& deploy, const std::filesystem::path& out,
                    const std::string& extra) {
@@ -54,11 +37,11 @@ TEST(Restart, ADensifierKilledMidRunIsRestartedAndReported) {
   std::thread killer([&] {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (std::chrono::steady_clock::now() < deadline &&
-           !pid_of(dir / "run" / "processes.json", "logplayer")) {
+           !running_pid(dir / "run" / "processes.json", "logplayer")) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     std::this_thread::sleep_for(std::chrono::seconds(3));
-    const int pid = pid_of(dir / "run" / "processes.json", "densifier");
+    const int pid = running_pid(dir / "run" / "processes.json", "densifier");
     if (pid > 0) kill(pid, SIGKILL);
     std::ofstream(dir / "killed") << pid;
   });
@@ -77,7 +60,7 @@ TEST(Restart, ADensifierKilledMidRunIsRestartedAndReported) {
                           "densifier\",\"restarts\":1"),
             std::string::npos)
       << r.output;
-  EXPECT_NE(read(dir / "run" / "processes.json").find("\"restarts\":1"), std::string::npos);
+  EXPECT_NE(read_text(dir / "run" / "processes.json").find("\"restarts\":1"), std::string::npos);
   // Its statuses in the recording come from two pids, the killed one first; the monitor counted
   // one restart.
   std::vector<int32_t> pids;
@@ -88,8 +71,8 @@ TEST(Restart, ADensifierKilledMidRunIsRestartedAndReported) {
   }
   ASSERT_EQ(pids.size(), 2u) << r.output;
   EXPECT_EQ(pids[0], killed);
-  EXPECT_NE(read(dir / "run" / "monitor.json").find("\"restarts\":1"), std::string::npos)
-      << read(dir / "run" / "monitor.json");
+  EXPECT_NE(read_text(dir / "run" / "monitor.json").find("\"restarts\":1"), std::string::npos)
+      << read_text(dir / "run" / "monitor.json");
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
@@ -136,7 +119,7 @@ TEST(Restart, ControlStopsAndStartsOneProcessOfARunningGraph) {
   std::string stopped, started, listed;
   std::thread operator_thread([&] {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    while (std::chrono::steady_clock::now() < deadline && !pid_of(status, "logplayer")) {
+    while (std::chrono::steady_clock::now() < deadline && !running_pid(status, "logplayer")) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     stopped = run(control + "stop --process frontend", 60).output;

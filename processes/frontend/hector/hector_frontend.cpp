@@ -7,19 +7,10 @@
 #include "deskew.hpp"
 #include "grid_search.hpp"
 #include "scan_matcher.hpp"
+#include "sweep_input.hpp"
 
 namespace traverse::frontend {
 namespace {
-
-// A sweep longer than this is not a sweep of a planar scanner: its times are wrong.
-constexpr int64_t kMaxSweepUs = 1'000'000;
-
-Eigen::Matrix3d rotation_rpy(double roll, double pitch, double yaw) {
-  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
 
 // Gives `result` the pose of a match and its figures (iterations add up).
 void take_match(FrontendResult& result, const MatchResult& m) {
@@ -39,22 +30,17 @@ HectorFrontend::HectorFrontend(const FrontendConfig& config)
       T_initial_(config.initial_pose.pose()),
       scan_points_(config.T_base_laser.pose(), config.matcher.min_range_m,
                    config.matcher.max_range_m),
-      motion_(T_initial_,
-              rotation_rpy(config.deskew.imu_roll_rad, config.deskew.imu_pitch_rad,
-                           config.deskew.imu_yaw_rad),
-              config.motion_prior),
+      motion_(T_initial_, R_base_imu(config.deskew), config.motion_prior),
       map_(config.map) {}
 
 bool HectorFrontend::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) {
-  const bool taken = motion_.add_imu(utime, angular_velocity_imu);
-  ++(taken ? counters_.imu_samples : counters_.imu_dropped);
-  return taken;
+  return counted(motion_.add_imu(utime, angular_velocity_imu), counters_.imu_samples,
+                 counters_.imu_dropped);
 }
 
 bool HectorFrontend::add_odometry(const OdometrySample& odometry) {
-  const bool taken = motion_.add_odometry(odometry);
-  ++(taken ? counters_.odometry_samples : counters_.odometry_dropped);
-  return taken;
+  return counted(motion_.add_odometry(odometry), counters_.odometry_samples,
+                 counters_.odometry_dropped);
 }
 
 Measurement HectorFrontend::measure(const Scan& scan) {
@@ -65,8 +51,8 @@ Measurement HectorFrontend::measure(const Scan& scan) {
   FrontendDiagnostics& d = r.diagnostics.emplace();
   const bool initialised = motion_.initialised();
   // Times first: a sweep ending before it starts, or not after the last pose, is dropped.
-  if (scan.utime_last < scan.utime_first || scan.utime_last - scan.utime_first > kMaxSweepUs ||
-      (initialised && scan.utime_last <= motion_.last_utime())) {
+  const int64_t last_utime = motion_.last_utime();
+  if (sweep_times_wrong(scan, initialised ? &last_utime : nullptr)) {
     ++counters_.scans_dropped_time;
     return m;
   }

@@ -1,0 +1,186 @@
+// Opens traverse-viewer's page in Debian's headless chromium (driven by playwright-core, which
+// downloads no browser) and checks what a person would see: a cloud, the legend of the standard,
+// and points in at least two accuracy colours, read from the page's state and from the pixels of
+// its WebGL canvas. Saves a screenshot.
+//
+//   node page_check.mjs --url http://127.0.0.1:PORT/ --screenshot FILE [--timeout S]
+//                       [--min-points N] [--cut-feed] [--watch S [--no-draw]]
+//
+// Two pages are opened side by side: the page as served, which must pass, and the same page with
+// its WebSocket cut (answered by a stand-in that never sends anything), which must fail: the check
+// would not notice a page that shows nothing. --cut-feed checks only the cut page, as if it were
+// the real one: the run then fails, as it must. Prints one JSON line last; exits 0 when the
+// served page passed and the cut one failed, 1 otherwise. --watch S only keeps one served page
+// open for S seconds, as an operator would (to measure what a connected browser costs the graph),
+// then prints what it showed and the CPU time chromium took [s]; with --no-draw the page is a
+// blank one that only reads the viewer's WebSocket (a browser on another device, as far as this
+// machine is concerned: the viewer does all its work, nothing is drawn here).
+import { chromium } from 'playwright-core';
+import { mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+
+const args = { timeout: 90, 'min-points': 1000 };
+for (let i = 2; i < process.argv.length; ++i) {
+  const key = process.argv[i].replace(/^--/, '');
+  if (key === 'cut-feed' || key === 'no-draw') args[key] = true;
+  else args[key] = process.argv[++i];
+}
+if (!args.url || !args.screenshot) {
+  console.error('usage: node page_check.mjs --url URL --screenshot FILE [--timeout S] [--min-points N] [--cut-feed]');
+  process.exit(2);
+}
+const minPoints = Number(args['min-points']);
+
+// What the page shows: its state, and the pixels of the cloud alone (key poses hidden) counted
+// by legend colour, with the whole map in view.
+async function look(page) {
+  return page.evaluate(() => {
+    const s = window.viewerState;
+    const out = {
+      connected: s.connected, frames: s.frames, points: s.points, profiles: s.profiles,
+      legend: s.legend ? s.legend.levels.map((l) => l.name) : [],
+      colours: s.legend ? Object.fromEntries(s.legend.levels.map((l) => [l.name, l.rgb.join(',')])) : {},
+      legendShown: document.querySelectorAll('#legend .swatch').length,
+      levelCounts: s.levelCounts, annotations: s.annotations, trajectoryPoses: s.trajectoryPoses,
+      processes: s.processes.length, pixels: {},
+    };
+    if (!s.legend || !window.viewer) return out;
+    window.viewer.fit();
+    window.viewer.keyPoints.visible = false;
+    window.viewer.render();
+    const gl = window.viewer.renderer.getContext();
+    const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight, px = new Uint8Array(w * h * 4);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    window.viewer.keyPoints.visible = true;
+    window.viewer.render();
+    for (const l of s.legend.levels) {
+      const key = l.rgb.join(',');
+      if (key in out.pixels) continue;  // levels may share a colour (all better than the best)
+      let n = 0;
+      for (let i = 0; i < px.length; i += 4) {
+        if (Math.abs(px[i] - l.rgb[0]) <= 2 && Math.abs(px[i + 1] - l.rgb[1]) <= 2 &&
+            Math.abs(px[i + 2] - l.rgb[2]) <= 2) ++n;
+      }
+      out.pixels[key] = n;
+    }
+    return out;
+  });
+}
+
+// Why what the page shows is not enough, or null when it is.
+function verdict(v) {
+  if (!v.connected) return 'the page has no live WebSocket';
+  if (v.points < minPoints) return `${v.points} points arrived (at least ${minPoints} expected)`;
+  if (v.legend.length < 2 || v.legendShown !== v.legend.length) {
+    return `legend: ${v.legend.length} levels, ${v.legendShown} shown`;
+  }
+  // Distinct colours, not levels: every level better than the best shares its green.
+  const coloured = new Set(Object.entries(v.levelCounts)
+    .filter(([name, n]) => name !== 'none' && n > 0).map(([name]) => v.colours[name]));
+  if (coloured.size < 2) return `points in ${coloured.size} accuracy colour(s) only`;
+  const drawn = Object.entries(v.pixels).filter(([, n]) => n >= 20);
+  if (drawn.length < 2) return `pixels in ${drawn.length} legend colour(s) only: ${JSON.stringify(v.pixels)}`;
+  return null;
+}
+
+// CPU time [s] of every process whose command line names `dir` (chromium's, by its profile).
+function cpuSeconds(dir) {
+  const tick = 100;  // USER_HZ on Linux
+  let total = 0;
+  for (const pid of readdirSync('/proc').filter((p) => /^\d+$/.test(p))) {
+    try {
+      if (!readFileSync(`/proc/${pid}/cmdline`, 'utf8').includes(dir)) continue;
+      const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
+      const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+      total += (Number(fields[11]) + Number(fields[12])) / tick;  // utime, stime
+    } catch {
+      // gone meanwhile
+    }
+  }
+  return Math.round(total * 100) / 100;
+}
+
+async function watch(context, seconds) {
+  const page = await context.newPage();
+  if (args['no-draw']) {
+    await page.goto('about:blank');
+    await page.evaluate((url) => {
+      window.fed = { connected: false, frames: 0, bytes: 0 };
+      const ws = new WebSocket(url.replace(/^http/, 'ws') + 'ws');
+      ws.binaryType = 'arraybuffer';
+      ws.onopen = () => { window.fed.connected = true; };
+      ws.onmessage = (e) => {
+        ++window.fed.frames;
+        window.fed.bytes += typeof e.data === 'string' ? e.data.length : e.data.byteLength;
+      };
+    }, args.url);
+  } else {
+    await page.goto(args.url);
+  }
+  await new Promise((r) => setTimeout(r, seconds * 1000));
+  const shown = await page.evaluate(() => {
+    if (window.fed) return window.fed;
+    const s = window.viewerState;
+    return { connected: s.connected, frames: s.frames, bytes: s.bytes, points: s.points, resets: s.resets };
+  });
+  shown.chromium_cpu_s = cpuSeconds(userDataDir);
+  if (!args['no-draw']) await page.screenshot({ path: args.screenshot });
+  return shown;
+}
+
+const userDataDir = mkdtempSync(join(tmpdir(), 'traverse-chromium-'));
+const context = await chromium.launchPersistentContext(userDataDir, {
+  executablePath: '/usr/bin/chromium',
+  headless: true,
+  viewport: { width: 1400, height: 900 },
+  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+});
+// The served page must pass within the timeout, the cut one fail.
+async function check(context, result) {
+  const cut = await context.newPage();
+  // The stand-in server: accepts the page's WebSocket and never sends.
+  await cut.routeWebSocket(/\/ws$/, () => {});
+  await cut.goto(args.url);
+  const served = args['cut-feed'] ? cut : await context.newPage();
+  if (served !== cut) await served.goto(args.url);
+  const errors = [];
+  served.on('pageerror', (e) => errors.push(String(e)));
+  const deadline = Date.now() + Number(args.timeout) * 1000;
+  let seen, why;
+  for (;;) {
+    seen = await look(served);
+    why = verdict(seen);
+    if (!why || Date.now() > deadline) break;
+    await new Promise((r) => setTimeout(r, 1000));
+  }
+  await served.screenshot({ path: args.screenshot });
+  result.page = seen;
+  result.page_problem = why;
+  result.page_errors = errors;
+  if (served !== cut) {
+    result.cut_page = await look(cut);
+    result.cut_page_problem = verdict(result.cut_page);
+  }
+  result.screenshot = args.screenshot;
+  if (served === cut) return false;
+  return !why && !!result.cut_page_problem && errors.length === 0;
+}
+
+const result = { url: args.url, cut_feed_only: !!args['cut-feed'] };
+let ok = false;
+try {
+  if (args.watch) {
+    result.watched = await watch(context, Number(args.watch));
+    ok = result.watched.connected;
+  } else {
+    ok = await check(context, result);
+  }
+} finally {
+  await context.close();
+  rmSync(userDataDir, { recursive: true, force: true });
+}
+result.ok = ok;
+console.log(JSON.stringify(result));
+process.exit(ok ? 0 : 1);
