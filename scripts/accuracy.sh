@@ -105,7 +105,7 @@ run_set() {
     extra+=("$("$PYTHON" "$ROOT/scripts/accuracy_tables.py" coverage "$run_dir/export")")
   fi
   "$PYTHON" "$ROOT/scripts/conf.py" merge "$json" "${extra[@]}" \
-    "{\"set\": $(json_str "$set"), \"wall_s\": $(($(date +%s) - t0)), \"date\": \"$(date +%F)\"}" \
+    "$("$PYTHON" "$ROOT/scripts/conf.py" object set="$set" wall_s:=$(($(date +%s) - t0)) date="$(date +%F)")" \
     >"$result.tmp"
   mv "$result.tmp" "$result"
   rm -rf "$run_dir"  # a whole route's record and cloud are gigabytes; its figures are kept

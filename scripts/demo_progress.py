@@ -2,12 +2,14 @@
 """Progress of a demo run, read from the files the run is writing (scripts/demo.sh starts it):
 which stage works, how many seconds of data it has done out of how many, and at what rate
 (seconds of data per second of wall time). The stages' files:
-  out/cache/*.lcmlog.tmp           the simulator (or the CARMEN driver) writing the input log
+  out/cache/INPUT*.lcmlog.tmp      the simulator (or the CARMEN driver) writing the input log
+                                   (--input INPUT: the start of its name, so that another run
+                                   simulating into the same folder is not taken for this one)
   OUT/<stage>.lcmlog               an offline stage's record (each event stamped with data time)
   OUT/run.lcmlog                   the live graph's recording: the frontend's newest pose time
                                    against its first (the first scan's; the sensor channels may
                                    not be recorded, --no-run-log)
-Usage: demo_progress.py --watch PID --out OUT --cache DIR [--total S] [--log FILE]
+Usage: demo_progress.py --watch PID --out OUT --cache DIR [--input INPUT] [--total S] [--log FILE]
 Prints a line every few seconds until process PID ends; --log FILE: the run's own output, where
 the simulator's summary line gives the total when --total is not known."""
 import argparse
@@ -79,8 +81,9 @@ def total_from_log(path):
     return None
 
 
-def newest_file(out, cache):
-    candidates = glob.glob(os.path.join(cache, "*.lcmlog.tmp")) + glob.glob(os.path.join(out, "*.lcmlog"))
+def newest_file(out, cache, prefix):
+    candidates = (glob.glob(os.path.join(cache, glob.escape(prefix) + "*.lcmlog.tmp"))
+                  + glob.glob(os.path.join(out, "*.lcmlog")))
     candidates = [c for c in candidates if os.path.exists(c)]
     return max(candidates, key=os.path.getmtime) if candidates else None
 
@@ -90,6 +93,7 @@ def main():
     ap.add_argument("--watch", type=int, required=True)
     ap.add_argument("--out", required=True)
     ap.add_argument("--cache", required=True)
+    ap.add_argument("--input", default="", help="the start of the input log's name in --cache")
     ap.add_argument("--total", type=float)
     ap.add_argument("--log")
     ap.add_argument("--every", type=float, default=10.0)
@@ -100,7 +104,7 @@ def main():
     last_print = 0.0
     while True:
         alive = os.path.exists(f"/proc/{a.watch}")
-        path = newest_file(a.out, a.cache)
+        path = newest_file(a.out, a.cache, a.input)
         if path and path not in watched and os.path.getmtime(path) >= time.time() - 60:
             name = os.path.basename(path)
             if name.endswith(".tmp"):

@@ -56,4 +56,6 @@ convert_carmen_log "$input" "$cache"
 out="$ROOT/out/eval/carmen-$name-$(stages_tag "$stages")${tag:+-$tag}"
 run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_REFERENCE
 echo "eval-carmen: $name stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"carmen\": $(json_str "$name"), \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"tag\": $(json_str "$tag"), \"config_sets\": $(config_sets_json), \"input\": $(json_str "$input"), \"lcm_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+merged_json "$("$PYTHON" "$ROOT/scripts/conf.py" object carmen="$name" stages="$stages" \
+  speed:="$speed" offline:="$([[ -n $OFFLINE ]] && echo true || echo false)" tag="$tag" \
+  config_sets:="$(config_sets_json)" input="$input" lcm_log="$cache" out_dir="$out")"

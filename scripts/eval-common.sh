@@ -239,21 +239,15 @@ cloud_evaluate() {
   fi
 }
 
-# merged_json '"key": value, ...': the evaluator's object with these fields first, the cloud
+# merged_json OBJECT (conf.py object's JSON): the evaluator's object with OBJECT's fields first, the cloud
 # evaluation's fields (when the mapper ran) after it, and the graph's JSON (when run-graph printed
 # one) under "graph".
 merged_json() {
-  "$PYTHON" "$ROOT/scripts/conf.py" merge "{$1}" "$EVAL_JSON" "${CLOUD_JSON:-}" \
+  "$PYTHON" "$ROOT/scripts/conf.py" merge "$1" "$EVAL_JSON" "${CLOUD_JSON:-}" \
     ${GRAPH_JSON:+graph="$GRAPH_JSON"}
 }
 
 # The CONFIG_SETS items as a JSON list.
 config_sets_json() {
   "$PYTHON" -c 'import json, sys; print(json.dumps(sys.argv[1:]))' "${CONFIG_SETS[@]}"
-}
-
-# A JSON string literal (quotes and backslashes escaped).
-json_str() {
-  local s="${1//\\/\\\\}"
-  echo "\"${s//\"/\\\"}\""
 }

@@ -126,4 +126,8 @@ if runs_mapper "$stages"; then
   cloud_evaluate "$world_file" "$out"
 fi
 echo "eval-route: $route seed $seed ($profile) stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"profile\": $(json_str "$profile"), \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"deskew_off\": $([[ -n $DESKEW_OFF ]] && echo true || echo false), \"tag\": $(json_str "$tag"), \"config_sets\": $(config_sets_json), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+merged_json "$("$PYTHON" "$ROOT/scripts/conf.py" object route="$route" seed:="$seed" \
+  profile="$profile" sim_duration_s:="${duration:-null}" stages="$stages" speed:="$speed" \
+  offline:="$([[ -n $OFFLINE ]] && echo true || echo false)" \
+  deskew_off:="$([[ -n $DESKEW_OFF ]] && echo true || echo false)" tag="$tag" \
+  config_sets:="$(config_sets_json)" sim_log="$cache" out_dir="$out")"

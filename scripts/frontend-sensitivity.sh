@@ -72,8 +72,8 @@ for ((i = 0; i < starts; i++)); do
   [[ $jump =~ ^[0-9.]+$ ]] || die "no max_jump_m in the evaluator's JSON of start $i"
   printf 'start %2d: x %.4f m, y %.4f m, theta %+.6f rad: largest jump %.3f m, rpe over 1 m %.3f m, over 10 m %.3f m\n' \
     "$i" "$x" "$y" "$theta" "$jump" "$rpe1" "$rpe10" >&2
-  conf merge "{\"x_m\": $x, \"y_m\": $y, \"theta_rad\": $theta}" \
-    "{\"max_jump_m\": $jump, \"rpe_1m_m\": $rpe1, \"rpe_10m_m\": $rpe10}" >"$dir/start.json"
+  conf object x_m:="$x" y_m:="$y" theta_rad:="$theta" max_jump_m:="$jump" rpe_1m_m:="$rpe1" \
+    rpe_10m_m:="$rpe10" >"$dir/start.json"
 done
 
 members_used="$(conf get "$out/start-0/frontend.yaml" matcher.sparse_ensemble_members 2>/dev/null)" ||

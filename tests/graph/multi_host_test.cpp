@@ -236,9 +236,9 @@ TEST(MultiHost, OneLauncherPerHostEachStartsItsOwnProcesses) {
       bin + "--host server --out " + (dir / "server").string() + " > " +
           (dir / "server.out").string() + " 2>&1 & server=$!; sleep 1; " + bin +
           "--host cart --log " + kLog + " --out " + (dir / "cart").string() +
-          " --grace 4 & cart=$!; sleep 2; until grep -q " + "\"logplayer[^}]*running.:false\" " +
-          cart_status +
-          " || ! kill -0 $cart; do sleep 0.2; done; kill -INT $server; wait $server; server=$?; " +
+          " --grace 4 & cart=$!; sleep 2; until [ \"$(python3 scripts/conf.py get " + cart_status +
+          " processes.logplayer.running 2>/dev/null)\" = false ] || ! kill -0 $cart; do sleep 0.2;"
+          " done; kill -INT $server; wait $server; server=$?; " +
           "wait $cart; echo cart=$? server=$server; cat " + (dir / "server.out").string(),
       120);
   EXPECT_NE(r.output.find("cart=0 server=130"), std::string::npos) << r.output;
