@@ -105,6 +105,7 @@ if [[ -n $carmen ]]; then
   name="$(basename "$carmen")"
   name="${name%.gz}" name="${name%.log}" name="${name%-corrected}"
   run_dir="$ROOT/out/eval/carmen-$name-${stages//,/+}"
+  input_prefix="carmen-$name."
   what="CARMEN log $carmen"
   total=""
   input_stage=convert
@@ -115,6 +116,7 @@ else
   cmd=("$ROOT/scripts/eval-route.sh" "$route" --stages "$stages" --seed "$seed" --profile "$profile"
     "${dur[@]}" ${offline:+--offline} "${record[@]}" --verdict-warns)
   run_dir="$ROOT/out/eval/$route-seed$seed${dur:+-d$duration}-$profile-${stages//,/+}"
+  input_prefix="$route-seed$seed${dur:+-d$duration}-$profile-"
   what="route $route, seed $seed, $profile profile, $([[ $duration == 0 ]] && echo "whole route" || echo "first $duration s")"
   total="$([[ $duration == 0 ]] || echo "$duration")"
   input_stage=simulate
@@ -131,7 +133,7 @@ mkdir -p "$run_dir"
 "${cmd[@]}" >"$logs/eval.out" 2>"$logs/eval.log" &
 run_pid=$!
 "$PY" "$ROOT/scripts/demo_progress.py" --watch "$run_pid" --out "$run_dir" \
-  --cache "$ROOT/out/cache" --log "$logs/eval.log" --input-stage "$input_stage" \
+  --cache "$ROOT/out/cache" --input "$input_prefix" --log "$logs/eval.log" --input-stage "$input_stage" \
   ${total:+--total "$total"} &
 progress_pid=$!
 rc=0
