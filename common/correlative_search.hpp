@@ -43,6 +43,9 @@ class ScoreTable {
   float& at(int i, int j) { return cells_[index(i, j)]; }
   float at(int i, int j) const { return cells_[index(i, j)]; }
   float operator()(int i, int j) const { return inside(i, j) ? at(i, j) : 0.0f; }
+  // The cells, row-major: cell (i, j) at j * width() + i.
+  const float* data() const { return cells_.data(); }
+  float* data() { return cells_.data(); }
 
  private:
   static std::size_t size(int width, int height) {

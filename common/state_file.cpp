@@ -120,7 +120,20 @@ RecordLog::~RecordLog() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-std::vector<std::string> RecordLog::read(const std::string& path, std::size_t max) {
+namespace {
+// One record as a log holds it: size, payload, hash.
+std::string record_bytes(const std::string& payload) {
+  const auto size = static_cast<uint32_t>(payload.size());
+  const uint64_t hash = fnv1a64(payload.data(), payload.size());
+  std::string record(reinterpret_cast<const char*>(&size), sizeof(size));
+  record += payload;
+  record.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
+  return record;
+}
+}  // namespace
+
+std::vector<std::string> RecordLog::read(const std::string& path, std::size_t max,
+                                         std::size_t* length) {
   bool exists = false;
   const std::string bytes = read_file(path, &exists);
   std::vector<std::string> out;
@@ -136,7 +149,26 @@ std::vector<std::string> RecordLog::read(const std::string& path, std::size_t ma
     out.emplace_back(payload, size);
     at += sizeof(size) + size + sizeof(hash);
   }
+  if (length) *length = at;
   return out;
+}
+
+bool RecordLog::write(const std::string& path, const std::vector<std::string>& records,
+                      std::string* error) {
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  bool ok = fd >= 0;
+  for (std::size_t i = 0; ok && i < records.size(); ++i) {
+    const std::string r = record_bytes(records[i]);
+    ok = write_all(fd, r.data(), r.size());
+  }
+  if (fd >= 0) ok = ::fdatasync(fd) == 0 && ::close(fd) == 0 && ok;
+  if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    set(error, "cannot write " + path);
+    std::remove(tmp.c_str());
+    return false;
+  }
+  return true;
 }
 
 bool RecordLog::open(const std::string& path, std::size_t keep, std::string* error) {
@@ -146,8 +178,14 @@ bool RecordLog::open(const std::string& path, std::size_t keep, std::string* err
                    std::to_string(keep) + " expected");
     return false;
   }
-  off_t length = 0;
-  for (const std::string& r : kept) length += static_cast<off_t>(sizeof(uint32_t) + r.size() + 8);
+  std::size_t length = 0;
+  for (const std::string& r : kept) length += sizeof(uint32_t) + r.size() + 8;
+  return open_at(path, length, error);
+}
+
+bool RecordLog::open_at(const std::string& path, std::size_t size, std::string* error) {
+  if (fd_ >= 0) ::close(fd_);
+  const auto length = static_cast<off_t>(size);
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0 || ::ftruncate(fd_, length) != 0 || ::lseek(fd_, length, SEEK_SET) != length) {
     set(error, "cannot append to " + path);
@@ -158,11 +196,7 @@ bool RecordLog::open(const std::string& path, std::size_t keep, std::string* err
 
 bool RecordLog::append(const std::string& payload) {
   if (fd_ < 0) return false;
-  const auto size = static_cast<uint32_t>(payload.size());
-  const uint64_t hash = fnv1a64(payload.data(), payload.size());
-  std::string record(reinterpret_cast<const char*>(&size), sizeof(size));
-  record += payload;
-  record.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
+  const std::string record = record_bytes(payload);
   return write_all(fd_, record.data(), record.size());
 }
 

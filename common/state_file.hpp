@@ -110,13 +110,22 @@ class RecordLog {
   // Opens `path` for appending after its first `keep` intact records (the file is cut there);
   // false with `error` set when it has fewer, or cannot be opened.
   bool open(const std::string& path, std::size_t keep, std::string* error = nullptr);
+  // Opens `path` for appending at byte `length` (the end of its intact records, as read() says;
+  // what follows, a record torn by a crash, is cut off).
+  bool open_at(const std::string& path, std::size_t length, std::string* error = nullptr);
   bool append(const std::string& payload);
   // Flushes what was appended to the disk (before a snapshot that counts it is renamed in).
   bool sync();
   bool is_open() const { return fd_ >= 0; }
 
-  // The intact records of `path` from the start, at most `max` of them (a missing file: none).
-  static std::vector<std::string> read(const std::string& path, std::size_t max);
+  // The intact records of `path` from the start, at most `max` of them (a missing file: none);
+  // `length`: set to the bytes they take.
+  static std::vector<std::string> read(const std::string& path, std::size_t max,
+                                       std::size_t* length = nullptr);
+  // Replaces `path` atomically by a log of `records` (written aside, flushed, renamed over it):
+  // a log compacted while the process may die.
+  static bool write(const std::string& path, const std::vector<std::string>& records,
+                    std::string* error = nullptr);
 
  private:
   int fd_ = -1;

@@ -4,7 +4,8 @@
   accuracy_tables.py coverage EXPORT_DIR   JSON: the share of dense poses whose position error
       (against ground_truth.tum, both in the map frame, tied at the first pose) lies within the
       pose's predicted 95 % bound (trajectory.csv's bound95_m); 0.95 is a consistent prediction
-  accuracy_tables.py tables OUT_DIR        out/accuracy/tables.md and tables.json from runs/*.json
+  accuracy_tables.py tables OUT_DIR COMMAND  out/accuracy/tables.md and tables.json from
+      runs/*.json, saying which COMMAND made them
 """
 import bisect
 import datetime
@@ -49,61 +50,78 @@ def fmt(v, scale=1.0, digits=1):
     return "n/a" if v is None else f"{v * scale:.{digits}f}"
 
 
-def tables(out):
+def row_key(r):
+    """(input, profile, seed, set) of a run: a simulated route, or a CARMEN log (real data)."""
+    name = r.get("route") or f"carmen-{r.get('carmen', '?')}"
+    return name, r.get("profile", "real"), r.get("seed", "n/a"), r.get("set", "default")
+
+
+def trajectory_cells(r):
+    """Position RMSE, SD, max [mm]; heading RMSE, SD, max [deg]."""
+    return [fmt(r.get("position_rmse_m"), 1000), fmt(r.get("position_sd_m"), 1000),
+            fmt(r.get("position_max_m"), 1000), fmt(r.get("heading_rmse_deg"), 1, 3),
+            fmt(r.get("heading_sd_deg"), 1, 3), fmt(r.get("heading_max_deg"), 1, 3)]
+
+
+def tables(out, command):
     runs = []
     for path in sorted(glob.glob(os.path.join(out, "runs", "*.json"))):
         with open(path) as f:
             runs.append(json.load(f))
-    by = {}
-    for r in runs:
-        by.setdefault((r["route"], r["profile"], r["seed"]), {})[r["part"]] = r
-    date = datetime.date.today().isoformat()
-    lines = [f"Made by `scripts/accuracy.sh` on {date} ({len(runs)} runs, offline).", "",
+    runs.sort(key=lambda r: tuple(str(k) for k in row_key(r)))
+    dates = sorted({r["date"] for r in runs if r.get("date")}) or [datetime.date.today().isoformat()]
+    made = dates[0] if len(dates) == 1 else f"{dates[0]} to {dates[-1]}"
+    durations = sorted({r.get("sim_duration_s") for r in runs if r.get("route")}, key=str)
+    span = ("the first " + " / ".join(f"{d:g} s" for d in durations if d) + " of every route"
+            if any(durations) else "whole routes")
+    lines = [f"Made by `{command}` ({made}; {len(runs)} runs, offline, {span}; "
+             f"{sum(r.get('wall_s', 0) for r in runs) / 3600:.1f} h of runs).", "",
              "Table 2 layout: trajectory errors against the simulator's ground truth (CARMEN logs: "
-             "against their reference poses), tied at the first pose; position in mm, heading in "
-             "degrees; coverage: dense poses within their predicted 95 % bound.", "",
-             "| route | profile | seed | frontend: pos RMSE | SD | max | hdg RMSE | SD | max "
-             "| full graph: pos RMSE | SD | max | hdg RMSE | SD | max | loop closures (false) "
-             "| 95 % bound coverage |", "|" + "---|" * 17]
-    for (route, profile, seed), parts in sorted(by.items()):
-        row = [route, profile, str(seed)]
-        for part in ("frontend", "graph"):
-            r = parts.get(part, {})
-            row += [fmt(r.get("position_rmse_m"), 1000), fmt(r.get("position_sd_m"), 1000),
-                    fmt(r.get("position_max_m"), 1000), fmt(r.get("heading_rmse_deg"), 1, 3),
-                    fmt(r.get("heading_sd_deg"), 1, 3), fmt(r.get("heading_max_deg"), 1, 3)]
-        g = parts.get("graph", {})
-        row.append(f"{g.get('loop_closures', 'n/a')} ({g.get('false_loop_closures', 'n/a')})")
-        row.append(fmt(g.get("bound95_coverage"), 100, 1) + (" %" if g.get("bound95_coverage") is not None else ""))
+             "against their reference poses, another system's estimate), tied at the first pose; "
+             "position in mm, heading in degrees; loop closures (false ones by the reference); "
+             "coverage: the share of dense poses whose error lies within their predicted 95 % bound "
+             "(95 % is consistent). Parameter sets: configs/accuracy.yaml.", "",
+             "| input | profile | seed | set | frontend: pos RMSE [mm] | SD [mm] | max [mm] "
+             "| hdg RMSE [deg] | SD [deg] | max [deg] | full graph: pos RMSE [mm] | SD [mm] "
+             "| max [mm] | hdg RMSE [deg] | SD [deg] | max [deg] | loop closures (false) "
+             "| 95 % bound coverage [%] | run wall-clock [s] |", "|" + "---|" * 19]
+    for r in runs:
+        row = [str(k) for k in row_key(r)]
+        row += trajectory_cells(r.get("frontend", {})) + trajectory_cells(r)
+        row.append(f"{r.get('loop_closures', 'n/a')} ({r.get('false_loop_closures', 'n/a')})")
+        row.append(fmt(r.get("bound95_coverage"), 100, 1))
+        row.append(str(r.get("wall_s", "n/a")))
         lines.append("| " + " | ".join(row) + " |")
-    lines += ["", "Table 3 layout: the full graph's cloud against the true surfaces (mm).", "",
-              "| route | profile | seed | points | mode | mean | RMSE | 95th percentile | pillar RMSE |",
-              "|" + "---|" * 9]
-    for (route, profile, seed), parts in sorted(by.items()):
-        g = parts.get("graph", {})
-        if "cloud_points" not in g:
+    lines += ["", "Table 3 layout: the full graph's cloud against the true surfaces of the "
+              "simulated world (distance of each point to the nearest surface, mm; pillar RMSE: "
+              "the pillars' fitted centres against the true ones).", "",
+              "| route | profile | seed | set | points | mode [mm] | mean [mm] | RMSE [mm] "
+              "| 95th percentile [mm] | pillar RMSE [mm] |", "|" + "---|" * 10]
+    for r in runs:
+        if "cloud_points" not in r:
             continue  # no profile scanner (a CARMEN log)
-        lines.append("| " + " | ".join([route, profile, str(seed), str(g.get("cloud_points", "n/a")),
-                                         fmt(g.get("cloud_mode_m"), 1000), fmt(g.get("cloud_mean_m"), 1000),
-                                         fmt(g.get("cloud_rmse_m"), 1000), fmt(g.get("cloud_p95_m"), 1000),
-                                         fmt(g.get("pillar_rmse_m"), 1000)]) + " |")
+        lines.append("| " + " | ".join([str(k) for k in row_key(r)] + [
+            f"{r['cloud_points']:,}", fmt(r.get("cloud_mode_m"), 1000), fmt(r.get("cloud_mean_m"), 1000),
+            fmt(r.get("cloud_rmse_m"), 1000), fmt(r.get("cloud_p95_m"), 1000),
+            fmt(r.get("pillar_rmse_m"), 1000)]) + " |")
     relations = os.path.join(out, "runs", "relations.md")
     if os.path.exists(relations):
         with open(relations) as f:
-            lines += ["", "The relations benchmark (Kümmerle et al. 2009; translational error mean ± SD "
-                      "in m, rotational in degrees):", "", f.read().strip()]
+            lines += ["", "The relations benchmark (Kümmerle et al. 2009, shipped configs; "
+                      "translational error mean ± SD in m, rotational in degrees):", "",
+                      f.read().strip()]
     text = "\n".join(lines) + "\n"
     with open(os.path.join(out, "tables.md"), "w") as f:
         f.write(text)
     with open(os.path.join(out, "tables.json"), "w") as f:
-        json.dump({"date": date, "runs": runs}, f, indent=1)
+        json.dump({"command": command, "dates": dates, "runs": runs}, f, indent=1)
     print(text)
 
 
 if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "coverage":
         coverage(sys.argv[2])
-    elif len(sys.argv) == 3 and sys.argv[1] == "tables":
-        tables(sys.argv[2])
+    elif len(sys.argv) == 4 and sys.argv[1] == "tables":
+        tables(sys.argv[2], sys.argv[3])
     else:
         sys.exit(__doc__)

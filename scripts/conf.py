@@ -11,6 +11,8 @@ json), never with sed or awk.
   conf.py merge ITEM...            one JSON object on stdout: each ITEM a JSON object (text, or
                                    @FILE for the last line of a file), merged in order; KEY=ITEM
                                    puts ITEM's object under KEY; an empty ITEM is skipped
+  conf.py object PAIR...           one JSON object on stdout from KEY=TEXT (a string, as is) and
+                                   KEY:=JSON (a number, true, null, a list ...) pairs, in order
 
 FILE may be - (standard input). PATH: keys separated by dots; a list element is chosen by
 index (processes.0.config) or by its name field (processes.frontend.config)."""
@@ -101,6 +103,17 @@ def main(argv):
                 out[key] = value
             else:
                 out.update(value)
+        print(json.dumps(out))
+    elif argv and argv[0] == "object":
+        out = {}
+        for pair in argv[1:]:
+            key, eq, value = pair.partition("=")
+            if not eq or not key:
+                sys.exit(f"conf.py object: expected KEY=TEXT or KEY:=JSON, not '{pair}'")
+            if key.endswith(":"):
+                out[key[:-1]] = json.loads(value)
+            else:
+                out[key] = value
         print(json.dumps(out))
     else:
         sys.exit(__doc__)

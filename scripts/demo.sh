@@ -21,8 +21,10 @@
 #                   estimate of the graph is in, the base at the first scan; the OctoMap's too) or
 #                   world (the simulator's, tied to the ground truth at the first pose; the
 #                   OctoMap stays in map)
-#   --no-run-log    do not keep the recorded run (run.lcmlog: every message of the run, the
-#                   largest file); the other products are written as usual
+#   --no-run-log    no run log (run.lcmlog: every message of the run, the largest file): the
+#                   sensor channels are not recorded at all; what the graph publishes is (a small
+#                   part of the size), for the evaluation and the export, and removed after them.
+#                   Every other product is written as usual
 #   --viewer        also run traverse-viewer (live runs): open the URL it prints in a browser to
 #                   watch the cloud grow in accuracy colours while the run goes on (the page
 #                   stays with what it showed when the run ends; configs/viewer.yaml sets
@@ -31,7 +33,11 @@
 # covariance of every pose), ground_truth.tum, cloud.ply and cloud.las (LAS 1.4: GPS time,
 # intensity, accuracy colour, level), map.bt and map.ot (OctoMap), report.json, report.md with
 # trajectory.png and errors.png, run.lcmlog, monitor.json, and logs/ (every process's output, the
-# evaluation's and the export's JSON, errors.csv, closures.csv).
+# evaluation's and the export's JSON, errors.csv, closures.csv). The input log it simulates (or
+# converts) is removed at the end: run.lcmlog holds every message of it.
+# Exit 0 after a clean run; 3 when the monitor's verdict fails (messages lost or a process
+# stalled, e.g. on a machine busy with other work: the products are written all the same and the
+# summary says what went wrong); 1 when something fails; 2 on a bad option.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
@@ -42,6 +48,9 @@ usage() {
 die() {
   echo "demo: $*" >&2
   exit 1
+}
+mb() {
+  echo "$(($(stat -c %s "$1") / 1000000)) MB"
 }
 
 route=office-s2 duration=180 seed=1 profile=realistic offline="" carmen="" thin=4 frame=""
@@ -84,14 +93,19 @@ PY=/usr/bin/python3
 [[ -x $PY ]] || PY=python3
 
 # 2. The run: the eval script simulates (or converts the CARMEN log), runs the graph and evaluates;
-# demo_progress.py reads the files it writes and prints the progress meanwhile.
+# demo_progress.py reads the files it writes and prints the progress meanwhile. Without the run
+# log, the graph's record leaves the sensor channels out.
+record=()
+[[ -n $keep_log ]] || record=(--record-outputs-only)
 if [[ -n $carmen ]]; then
   carmen="$(cd "$(dirname "$carmen")" && pwd)/$(basename "$carmen")"
   stages=frontend,backend,densifier${viewer:+,viewer}
-  cmd=("$ROOT/scripts/eval-carmen.sh" "$carmen" --stages "$stages" ${offline:+--offline})
+  cmd=("$ROOT/scripts/eval-carmen.sh" "$carmen" --stages "$stages" ${offline:+--offline}
+    "${record[@]}" --verdict-warns)
   name="$(basename "$carmen")"
   name="${name%.gz}" name="${name%.log}" name="${name%-corrected}"
   run_dir="$ROOT/out/eval/carmen-$name-${stages//,/+}"
+  input_prefix="carmen-$name."
   what="CARMEN log $carmen"
   total=""
   input_stage=convert
@@ -99,9 +113,10 @@ else
   stages=all${viewer:+,viewer}
   dur=()
   [[ $duration != 0 ]] && dur=(--duration "$duration")
-  cmd=("$ROOT/scripts/eval-route.sh" "$route" --stages all --seed "$seed" --profile "$profile"
-    "${dur[@]}" ${offline:+--offline})
+  cmd=("$ROOT/scripts/eval-route.sh" "$route" --stages "$stages" --seed "$seed" --profile "$profile"
+    "${dur[@]}" ${offline:+--offline} "${record[@]}" --verdict-warns)
   run_dir="$ROOT/out/eval/$route-seed$seed${dur:+-d$duration}-$profile-${stages//,/+}"
+  input_prefix="$route-seed$seed${dur:+-d$duration}-$profile-"
   what="route $route, seed $seed, $profile profile, $([[ $duration == 0 ]] && echo "whole route" || echo "first $duration s")"
   total="$([[ $duration == 0 ]] || echo "$duration")"
   input_stage=simulate
@@ -118,7 +133,7 @@ mkdir -p "$run_dir"
 "${cmd[@]}" >"$logs/eval.out" 2>"$logs/eval.log" &
 run_pid=$!
 "$PY" "$ROOT/scripts/demo_progress.py" --watch "$run_pid" --out "$run_dir" \
-  --cache "$ROOT/out/cache" --log "$logs/eval.log" --input-stage "$input_stage" \
+  --cache "$ROOT/out/cache" --input "$input_prefix" --log "$logs/eval.log" --input-stage "$input_stage" \
   ${total:+--total "$total"} &
 progress_pid=$!
 rc=0
@@ -131,14 +146,22 @@ fi
 tail -n 1 "$logs/eval.out" >"$logs/eval.json"
 
 # 3. Products into the output folder.
-echo "demo: [3/4] export (trajectory and cloud in frame $frame, $([[ $thin == 1 ]] && echo "every point" || echo "one point in $thin"))"
+if [[ -n $carmen ]]; then
+  echo "demo: [3/4] export (trajectory in frame $frame; a 2D scanner's log makes no cloud)"
+else
+  echo "demo: [3/4] export (trajectory and cloud in frame $frame, $([[ $thin == 1 ]] && echo "every point" || echo "one point in $thin"))"
+fi
 for f in "$run_dir"/*.log "$run_dir"/*.out "$run_dir"/run-graph.json "$run_dir"/errors.csv "$run_dir"/closures.csv; do
   [[ -e $f ]] && mv "$f" "$logs/"
 done
+rm -f "$out/monitor.json" "$out/errors.png"
+# (What an earlier demo left here: a CARMEN run writes reference.tum, a simulated one
+# ground_truth.tum, and no other run's product may stand beside this one's.)
+(cd "$out" && rm -f trajectory.tum trajectory.csv ground_truth.tum reference.tum cloud.ply \
+  cloud.las map.bt map.ot report.json report.md trajectory.png run.lcmlog)
 for f in monitor.json errors.png; do
   [[ -e $run_dir/$f ]] && mv "$run_dir/$f" "$out/$f"
 done
-rm -f "$out"/map.bt "$out"/map.ot "$out"/cloud.ply "$out"/cloud.las "$out"/run.lcmlog
 export_args=(--reference POSE_GROUND_TRUTH)
 [[ -n $carmen ]] && export_args=(--reference POSE_REFERENCE)
 if [[ -f $run_dir/mapper/cloud.ply ]]; then
@@ -149,11 +172,34 @@ fi
   --frame "$frame" --thin "$thin" >"$logs/export.out" 2>"$logs/export.log" ||
   { cat "$logs/export.log" >&2; die "traverse-export failed"; }
 mv "$out/export.json" "$logs/export.json"
+skipped=()
 if [[ -n $keep_log ]]; then
   mv "$run_dir/run.lcmlog" "$out/run.lcmlog"
+else
+  skipped+=("run.lcmlog (--no-run-log): the sensor channels were never recorded; what the graph published ($(mb "$run_dir/run.lcmlog")) was, for the evaluation and the export, and is removed")
+fi
+if [[ -f $run_dir/mapper/cloud.ply ]]; then
+  skipped+=("the mapper's full-density cloud ($(mb "$run_dir/mapper/cloud.ply")): cloud.las and cloud.ply hold one point in ${thin} of it (--thin 1: all)")
 fi
 rm -rf "$run_dir"
+# The input this run simulated (or converted) is removed: every message of it is in run.lcmlog,
+# and the next run makes it again (a log an earlier run made and this one reused is left alone).
+input_log="$("$PY" "$ROOT/scripts/conf.py" get "$logs/eval.json" sim_log 2>/dev/null ||
+  "$PY" "$ROOT/scripts/conf.py" get "$logs/eval.json" lcm_log 2>/dev/null || true)"
+if [[ -f $input_log ]] && (($(stat -c %Y "$input_log") >= t0)); then
+  skipped+=("the input log out/cache/$(basename "$input_log") ($(mb "$input_log")): ${keep_log:+every message of it is in run.lcmlog; }made again by the next run")
+  rm -f "$input_log" "$input_log.json" "$input_log.out"
+fi
 
 # 4. The report (JSON, Markdown with the plot) and the summary.
 echo "demo: [4/4] report"
-"$PY" "$ROOT/scripts/demo_report.py" --out "$out" --what "$what" --seconds "$(($(date +%s) - t0))"
+notes=()
+for n in "${skipped[@]}"; do notes+=(--removed "$n"); done
+"$PY" "$ROOT/scripts/demo_report.py" --out "$out" --what "$what" --seconds "$(($(date +%s) - t0))" \
+  "${notes[@]}"
+if [[ $("$PY" "$ROOT/scripts/conf.py" get "$out/monitor.json" ok 2>/dev/null) != true ]]; then
+  echo "demo: the monitor's verdict failed ($out/monitor.json, problems above): the products are" \
+    "those of a run that lost messages or had a process stall; on a machine busy with other work," \
+    "--offline runs the same stages without a bus" >&2
+  exit 3
+fi

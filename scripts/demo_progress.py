@@ -2,11 +2,14 @@
 """Progress of a demo run, read from the files the run is writing (scripts/demo.sh starts it):
 which stage works, how many seconds of data it has done out of how many, and at what rate
 (seconds of data per second of wall time). The stages' files:
-  out/cache/*.lcmlog.tmp           the simulator (or the CARMEN driver) writing the input log
+  out/cache/INPUT*.lcmlog.tmp      the simulator (or the CARMEN driver) writing the input log
+                                   (--input INPUT: the start of its name, so that another run
+                                   simulating into the same folder is not taken for this one)
   OUT/<stage>.lcmlog               an offline stage's record (each event stamped with data time)
   OUT/run.lcmlog                   the live graph's recording: the frontend's newest pose time
-                                   against the first scan's
-Usage: demo_progress.py --watch PID --out OUT --cache DIR [--total S] [--log FILE]
+                                   against its first (the first scan's; the sensor channels may
+                                   not be recorded, --no-run-log)
+Usage: demo_progress.py --watch PID --out OUT --cache DIR [--input INPUT] [--total S] [--log FILE]
 Prints a line every few seconds until process PID ends; --log FILE: the run's own output, where
 the simulator's summary line gives the total when --total is not known."""
 import argparse
@@ -31,8 +34,7 @@ class Watched:
         self.types = lcmlog.message_types() if live else None
 
     def update(self):
-        wanted = {"POSE_FRONTEND", "KEY_POSES"} | ({"SCAN_HORIZONTAL"} if self.first is None else set())
-        wanted = wanted if self.live else None
+        wanted = {"POSE_FRONTEND", "KEY_POSES"} if self.live else None
         try:
             for offset, utime, channel, data in lcmlog.events(self.path, self.offset, wanted):
                 self.offset = offset
@@ -42,9 +44,9 @@ class Watched:
                     msg = lcmlog.decode(self.types, data)
                     if msg is None:
                         continue
-                    if channel == "SCAN_HORIZONTAL" and self.first is None:
-                        self.first = msg.utime_first if hasattr(msg, "utime_first") else msg.utime
                     if channel == "POSE_FRONTEND":
+                        # The first pose is the first scan's: the span of data the graph has done.
+                        self.first = msg.utime if self.first is None else self.first
                         self.newest = msg.utime
                     if channel == "KEY_POSES":
                         self.key_poses, self.closures = msg.total_key_poses, msg.total_loop_closures
@@ -62,18 +64,26 @@ class Watched:
 
 
 def total_from_log(path):
+    """The simulator's sim_duration_s, from its JSON line in the run's output (None until then)."""
     try:
         with open(path) as f:
             for line in f:
-                if line.startswith("{") and '"sim_duration_s"' in line:
-                    return json.loads(line).get("sim_duration_s")
-    except (OSError, ValueError):
+                if not line.startswith("{"):
+                    continue
+                try:
+                    value = json.loads(line).get("sim_duration_s")
+                except ValueError:
+                    continue
+                if value is not None:
+                    return value
+    except OSError:
         pass
     return None
 
 
-def newest_file(out, cache):
-    candidates = glob.glob(os.path.join(cache, "*.lcmlog.tmp")) + glob.glob(os.path.join(out, "*.lcmlog"))
+def newest_file(out, cache, prefix):
+    candidates = (glob.glob(os.path.join(cache, glob.escape(prefix) + "*.lcmlog.tmp"))
+                  + glob.glob(os.path.join(out, "*.lcmlog")))
     candidates = [c for c in candidates if os.path.exists(c)]
     return max(candidates, key=os.path.getmtime) if candidates else None
 
@@ -83,6 +93,7 @@ def main():
     ap.add_argument("--watch", type=int, required=True)
     ap.add_argument("--out", required=True)
     ap.add_argument("--cache", required=True)
+    ap.add_argument("--input", default="", help="the start of the input log's name in --cache")
     ap.add_argument("--total", type=float)
     ap.add_argument("--log")
     ap.add_argument("--every", type=float, default=10.0)
@@ -93,7 +104,7 @@ def main():
     last_print = 0.0
     while True:
         alive = os.path.exists(f"/proc/{a.watch}")
-        path = newest_file(a.out, a.cache)
+        path = newest_file(a.out, a.cache, a.input)
         if path and path not in watched and os.path.getmtime(path) >= time.time() - 60:
             name = os.path.basename(path)
             if name.endswith(".tmp"):

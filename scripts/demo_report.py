@@ -20,8 +20,8 @@ PRODUCTS = [  # (file, what)
     ("reference.tum", "the CARMEN log's reference poses (another SLAM system's), TUM format"),
     ("cloud.ply", "point cloud, PLY (accuracy colour, level)"),
     ("cloud.las", "point cloud, LAS 1.4 (GPS time, intensity, accuracy colour, level)"),
-    ("map.bt", "OctoMap, binary"),
-    ("map.ot", "OctoMap, full"),
+    ("map.bt", "OctoMap, binary (map frame, whatever --frame says: a voxel grid does not turn)"),
+    ("map.ot", "OctoMap, full (map frame)"),
     ("report.md", "accuracy report, Markdown"),
     ("report.json", "accuracy report, every figure"),
     ("trajectory.png", "trajectory plot"),
@@ -72,6 +72,8 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("--what", required=True)
     ap.add_argument("--seconds", type=float, required=True)
+    ap.add_argument("--removed", action="append", default=[],
+                    help="what the run made and did not keep, and why (said in the summary)")
     a = ap.parse_args()
     out = a.out
     ev, ex = load(f"{out}/logs/eval.json"), load(f"{out}/logs/export.json")
@@ -120,7 +122,9 @@ def main():
         path = os.path.join(out, name)
         if os.path.exists(path) or name in ("report.md", "report.json"):
             files.append((name, what, path))
-    report = {"what": a.what, "wall_s": a.seconds, "frame": frame, "evaluation": ev, "export": ex,
+    report = {"what": a.what, "wall_s": a.seconds, "frame": frame,
+              "frames": {"trajectory": frame, "cloud": frame, "octomap": "map"}, "not_kept": a.removed,
+              "evaluation": ev, "export": ex,
               "monitor": {"ok": mon.get("ok"), "problems": mon.get("problems", [])}}
     with open(f"{out}/report.json", "w") as f:
         json.dump(report, f, indent=2)
@@ -139,6 +143,8 @@ def main():
         f.write("| file | what |\n|---|---|\n")
         for name, what, _ in files:
             f.write(f"| `{name}` | {what} |\n")
+        for r in a.removed:
+            f.write(f"\nNot kept: {r}.\n")
 
     print()
     for k, v in headline:
@@ -151,6 +157,8 @@ def main():
         total += n
         print(f"  {name + ('/' if os.path.isdir(path) else ''):17} {size_text(n):>9}  {what}")
     print(f"  {'total':17} {size_text(total):>9}")
+    for r in a.removed:
+        print(f"  not kept: {r}")
     print(f"\nFull figures: {out}/report.json; report with plots: {out}/report.md")
 
 

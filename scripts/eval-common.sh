@@ -99,30 +99,59 @@ stale() {
   return 1
 }
 
+# The input's sensor channels (and the simulator's 3D truth): with RECORD_OUTPUTS_ONLY=1 the run's
+# record leaves them out and keeps what the graph published, its statuses and the 2D reference,
+# everything the evaluation and traverse-export read (eval-route.sh --record-outputs-only).
+SENSOR_CHANNELS='SCAN_HORIZONTAL|SCAN_PROFILE|IMU|ODOMETRY|POSE_GROUND_TRUTH_3D'
+
+# CONFIG_SETS: "PROCESS.KEY=VALUE" items (eval-route.sh --set): KEY (dotted) set to VALUE (YAML) in
+# the config file configs/deploy/pipeline.yaml gives PROCESS. deployment_for OUTDIR writes the
+# changed configs (OUTDIR/PROCESS.yaml) and the deployment using them (OUTDIR/pipeline.yaml) and
+# prints its path; with no item, configs/deploy/pipeline.yaml itself.
+CONFIG_SETS=()
+deployment_for() {
+  local out="$1" deploy="$ROOT/configs/deploy/pipeline.yaml" item process key value config
+  if ((${#CONFIG_SETS[@]} == 0)); then
+    echo "$deploy"
+    return
+  fi
+  cp "$deploy" "$out/pipeline.yaml"
+  for item in "${CONFIG_SETS[@]}"; do
+    [[ $item =~ ^([A-Za-z0-9_-]+)\.([A-Za-z0-9_.]+)=(.*)$ ]] ||
+      die "--set $item: expected PROCESS.KEY=VALUE, e.g. frontend.deskew.enabled=false"
+    process="${BASH_REMATCH[1]}" key="${BASH_REMATCH[2]}" value="${BASH_REMATCH[3]}"
+    config="$("$PYTHON" "$ROOT/scripts/conf.py" get "$out/pipeline.yaml" "processes.$process.config" 2>/dev/null)" ||
+      die "--set $item: configs/deploy/pipeline.yaml runs no process '$process' with a config"
+    [[ $config == /* ]] || config="$ROOT/$config"
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$config" "$key" "$value" >"$out/$process.yaml.tmp" ||
+      die "--set $item: cannot set $key in $config"
+    mv "$out/$process.yaml.tmp" "$out/$process.yaml"
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$out/pipeline.yaml" "processes.$process.config" \
+      "$out/$process.yaml" >"$out/pipeline.yaml.tmp"
+    mv "$out/pipeline.yaml.tmp" "$out/pipeline.yaml"
+  done
+  echo "$out/pipeline.yaml"
+}
+
 # run_graph IN OUTDIR STAGES SPEED: runs the stages on IN; OUTDIR/run.lcmlog records every
-# channel. With OFFLINE=1 the stages run one after another on the log instead of live on a bus
-# (traverse-launch --offline: no transport loss, as fast as they compute, same result each time). Its output goes to OUTDIR/graph.out; its JSON line (if any) is kept in GRAPH_JSON.
-# With DESKEW_OFF=1 the frontend runs with configs/frontend.yaml but deskew.enabled false (the
-# config and the pipeline using it are written to OUTDIR).
+# channel (RECORD_OUTPUTS_ONLY=1: all but SENSOR_CHANNELS). With OFFLINE=1 the stages run one
+# after another on the log instead of live on a bus (traverse-launch --offline: no transport loss,
+# as fast as they compute, same result each time). Its output goes to OUTDIR/graph.out; its JSON
+# line (if any) is kept in GRAPH_JSON. The configs are those of CONFIG_SETS (deployment_for).
 run_graph() {
   local in="$1" out="$2" stages="$3" speed="$4"
   [[ -x $ROOT/scripts/run-graph.sh ]] || die "scripts/run-graph.sh not found"
-  local rc=0 deploy="$ROOT/configs/deploy/pipeline.yaml"
-  if [[ -n ${DESKEW_OFF:-} ]]; then
-    "$PYTHON" "$ROOT/scripts/conf.py" set "$ROOT/configs/frontend.yaml" deskew.enabled false \
-      >"$out/frontend-deskew-off.yaml" ||
-      die "configs/frontend.yaml has no deskew.enabled to switch off"
-    [[ $("$PYTHON" "$ROOT/scripts/conf.py" get "$deploy" processes.frontend.config) == configs/frontend.yaml ]] ||
-      die "configs/deploy/pipeline.yaml does not run the frontend with configs/frontend.yaml"
-    "$PYTHON" "$ROOT/scripts/conf.py" set "$deploy" processes.frontend.config \
-      "$out/frontend-deskew-off.yaml" >"$out/pipeline-deskew-off.yaml"
-    deploy="$out/pipeline-deskew-off.yaml"
-  fi
+  local rc=0 deploy
+  deploy="$(deployment_for "$out")"
   TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$deploy" \
     --log "$in" --out "$out" --speed "$speed" --stages "$stages" ${OFFLINE:+--offline} \
-    >"$out/graph.out" 2>&1 || rc=$?
+    ${RECORD_OUTPUTS_ONLY:+--record-without "$SENSOR_CHANNELS"} >"$out/graph.out" 2>&1 || rc=$?
   GRAPH_JSON="$(last_json_line "$out/graph.out")"
-  if ((rc != 0)); then
+  if ((rc == 3)) && [[ -n ${VERDICT_WARNS:-} ]]; then
+    # Every process ran to the end; the monitor found losses or a stall (--verdict-warns).
+    grep 'VERDICT' "$out/graph.out" >&2 || true
+    echo "$(basename "$0"): the run's verdict failed (see $out/monitor.json); evaluated anyway, \"graph\": {\"ok\": false} in the JSON" >&2
+  elif ((rc != 0)); then
     tail -n 20 "$out/graph.out" >&2
     die "run-graph failed (exit $rc), see $out/graph.out"
   fi
@@ -210,16 +239,15 @@ cloud_evaluate() {
   fi
 }
 
-# merged_json '"key": value, ...': the evaluator's object with these fields first, the cloud
+# merged_json OBJECT (conf.py object's JSON): the evaluator's object with OBJECT's fields first, the cloud
 # evaluation's fields (when the mapper ran) after it, and the graph's JSON (when run-graph printed
 # one) under "graph".
 merged_json() {
-  "$PYTHON" "$ROOT/scripts/conf.py" merge "{$1}" "$EVAL_JSON" "${CLOUD_JSON:-}" \
+  "$PYTHON" "$ROOT/scripts/conf.py" merge "$1" "$EVAL_JSON" "${CLOUD_JSON:-}" \
     ${GRAPH_JSON:+graph="$GRAPH_JSON"}
 }
 
-# A JSON string literal (quotes and backslashes escaped).
-json_str() {
-  local s="${1//\\/\\\\}"
-  echo "\"${s//\"/\\\"}\""
+# The CONFIG_SETS items as a JSON list.
+config_sets_json() {
+  "$PYTHON" -c 'import json, sys; print(json.dumps(sys.argv[1:]))' "${CONFIG_SETS[@]}"
 }

@@ -103,7 +103,9 @@ PY
 )"
   echo "eval-coverage: covariance_scale fitted on $fit_runs: $scale" >&2
   sed -i "s|^covariance_scale:.*|covariance_scale: $scale  # fitted by scripts/eval-coverage.sh --fit on $fit_runs|" "$config"
-  grep -q "^covariance_scale: $scale " "$config" || die "could not write covariance_scale into $config"
+  # The comment beside the key stays (a YAML writer would drop it); the parser checks the result.
+  [[ $("$PYTHON" "$ROOT/scripts/conf.py" get "$config" covariance_scale) == "$scale" ]] ||
+    die "could not write covariance_scale into $config"
 fi
 
 names=() files=() fitted=()

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--profile P] [--speed S] [--offline]
-#                       [--duration S] [--deskew-off]
+#                       [--duration S] [--deskew-off] [--set PROCESS.KEY=VALUE ...] [--tag NAME]
+#                       [--record-outputs-only] [--verdict-warns]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim, configs/sim.yaml and configs/rig.yaml (cached as
@@ -24,9 +25,21 @@
 #                  every time; --speed is then ignored
 #   --deskew-off   the frontend with configs/frontend.yaml but deskew.enabled false, to measure
 #                  what de-skew buys (outputs under ROUTE-seedN-STAGES-deskew-off)
+#   --set P.K=V    run process P (of configs/deploy/pipeline.yaml) with key K of its config set to
+#                  V, e.g. --set backend.backend.link.resolution_m=0.01 (repeatable; the changed
+#                  configs are written to the output folder); give the run a --tag
+#   --tag NAME     outputs under ROUTE-seedN-PROFILE-STAGES-NAME
+#   --record-outputs-only  run.lcmlog without the sensor channels (scans, IMU, odometry, 3D truth):
+#                  what the graph published, the statuses and the 2D ground truth, all the
+#                  evaluation needs, a small part of the size
+#   --verdict-warns  a run whose verdict fails (run-graph exit 3: every process ran to the end
+#                  but the monitor found messages lost or a process stalled) is evaluated anyway;
+#                  the JSON's graph.ok is false (without it the script fails)
 set -euo pipefail
 OFFLINE=""
 DESKEW_OFF=""
+RECORD_OUTPUTS_ONLY=""
+VERDICT_WARNS=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -35,7 +48,7 @@ usage() {
   exit "${1:-2}"
 }
 
-route="" stages="" seed=1 speed=1 duration="" profile=realistic
+route="" stages="" seed=1 speed=1 duration="" profile=realistic tag=""
 while (($#)); do
   case "$1" in
     --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
@@ -45,6 +58,10 @@ while (($#)); do
     --offline) OFFLINE=1; shift ;;
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
     --deskew-off) DESKEW_OFF=1; shift ;;
+    --set) CONFIG_SETS+=("${2:?--set needs PROCESS.KEY=VALUE}"); shift 2 ;;
+    --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
+    --record-outputs-only) RECORD_OUTPUTS_ONLY=1; shift ;;
+    --verdict-warns) VERDICT_WARNS=1; shift ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $route ]] || usage; route="$1"; shift ;;
@@ -55,6 +72,8 @@ done
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, not '$seed'"
 [[ $profile == ideal || $profile == realistic ]] || die "--profile must be ideal or realistic, not '$profile'"
 [[ -z $duration || $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--duration must be seconds, not '$duration'"
+[[ -z $tag || $tag =~ ^[A-Za-z0-9._-]+$ ]] || die "--tag must be a plain name, not '$tag'"
+[[ -z $DESKEW_OFF ]] || CONFIG_SETS+=(frontend.deskew.enabled=false)
 
 route_file="$ROOT/configs/routes/$route.yaml"
 [[ -f $route_file ]] || die "no route $route_file (routes: $(cd "$ROOT/configs/routes" && ls *.yaml | sed 's/\.yaml$//' | tr '\n' ' '))"
@@ -100,11 +119,15 @@ if stale "$cache" "$BIN/traverse-sim"; then
 fi
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
-out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")${DESKEW_OFF:+-deskew-off}"
+out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")${DESKEW_OFF:+-deskew-off}${tag:+-$tag}"
 run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_GROUND_TRUTH
 if runs_mapper "$stages"; then
   need_programs traverse-cloud-eval
   cloud_evaluate "$world_file" "$out"
 fi
 echo "eval-route: $route seed $seed ($profile) stages ${stages:-none}: outputs in $out" >&2
-merged_json "\"route\": $(json_str "$route"), \"seed\": $seed, \"profile\": $(json_str "$profile"), \"sim_duration_s\": ${duration:-null}, \"stages\": $(json_str "$stages"), \"speed\": $speed, \"offline\": $([[ -n $OFFLINE ]] && echo true || echo false), \"deskew_off\": $([[ -n $DESKEW_OFF ]] && echo true || echo false), \"sim_log\": $(json_str "$cache"), \"out_dir\": $(json_str "$out")"
+merged_json "$("$PYTHON" "$ROOT/scripts/conf.py" object route="$route" seed:="$seed" \
+  profile="$profile" sim_duration_s:="${duration:-null}" stages="$stages" speed:="$speed" \
+  offline:="$([[ -n $OFFLINE ]] && echo true || echo false)" \
+  deskew_off:="$([[ -n $DESKEW_OFF ]] && echo true || echo false)" tag="$tag" \
+  config_sets:="$(config_sets_json)" sim_log="$cache" out_dir="$out")"

@@ -46,8 +46,6 @@ conf() { "$PYTHON" "$ROOT/scripts/conf.py" "$@"; }
 out="$ROOT/out/sensitivity/carmen-$name${members:+-members$members}"
 rm -rf "$out"
 mkdir -p "$out"
-runs=""
-jumps=() rpe10s=()
 for ((i = 0; i < starts; i++)); do
   # Start i: fractional parts of i times irrational steps (an additive recurrence), scaled to
   # [0, 0.1) m in x and y and [-1, 1) degree; start 0 is the identity.
@@ -74,16 +72,26 @@ for ((i = 0; i < starts; i++)); do
   [[ $jump =~ ^[0-9.]+$ ]] || die "no max_jump_m in the evaluator's JSON of start $i"
   printf 'start %2d: x %.4f m, y %.4f m, theta %+.6f rad: largest jump %.3f m, rpe over 1 m %.3f m, over 10 m %.3f m\n' \
     "$i" "$x" "$y" "$theta" "$jump" "$rpe1" "$rpe10" >&2
-  jumps+=("$jump")
-  rpe10s+=("$rpe10")
-  runs+="${runs:+, }{\"x_m\": $x, \"y_m\": $y, \"theta_rad\": $theta, \"max_jump_m\": $jump, \"rpe_1m_m\": $rpe1, \"rpe_10m_m\": $rpe10}"
+  conf object x_m:="$x" y_m:="$y" theta_rad:="$theta" max_jump_m:="$jump" rpe_1m_m:="$rpe1" \
+    rpe_10m_m:="$rpe10" >"$dir/start.json"
 done
 
-read -r median worst over < <(printf '%s\n' "${jumps[@]}" | sort -g | awk '
-  { v[NR] = $1; if ($1 > 0.5) n++ }
-  END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%.6f %.6f %d\n", m, v[NR], n }')
-rpe10_worst="$(printf '%s\n' "${rpe10s[@]}" | sort -g | tail -n 1)"
 members_used="$(conf get "$out/start-0/frontend.yaml" matcher.sparse_ensemble_members 2>/dev/null)" ||
   members_used="null"  # the frontend's default (frontend_config.hpp)
-echo "frontend-sensitivity: $name, $starts starts, $members_used-member ensemble: largest jump median $median m, worst $worst m, $over starts over 0.5 m; rpe over 10 m worst $rpe10_worst m; outputs in $out" >&2
-echo "{\"carmen\": $(json_str "$name"), \"starts\": $starts, \"sparse_ensemble_members\": $members_used, \"max_jump_median_m\": $median, \"max_jump_worst_m\": $worst, \"starts_over_0_5_m\": $over, \"rpe_10m_worst_m\": $rpe10_worst, \"runs\": [$runs], \"out_dir\": $(json_str "$out")}"
+# Over the starts: the median and worst largest jump, starts over 0.5 m, the worst RPE over 10 m.
+"$PYTHON" - "$name" "$starts" "$members_used" "$out" <<'PY'
+import json, statistics, sys
+name, starts, members, out = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3]), sys.argv[4]
+runs = [json.load(open(f"{out}/start-{i}/start.json")) for i in range(starts)]
+jumps = [r["max_jump_m"] for r in runs]
+summary = {"carmen": name, "starts": starts, "sparse_ensemble_members": members,
+           "max_jump_median_m": statistics.median(jumps), "max_jump_worst_m": max(jumps),
+           "starts_over_0_5_m": sum(j > 0.5 for j in jumps),
+           "rpe_10m_worst_m": max((r["rpe_10m_m"] for r in runs if r["rpe_10m_m"] is not None),
+                                  default=None), "runs": runs, "out_dir": out}
+print(f"frontend-sensitivity: {name}, {starts} starts, {members}-member ensemble: largest jump "
+      f"median {summary['max_jump_median_m']:.6f} m, worst {summary['max_jump_worst_m']:.6f} m, "
+      f"{summary['starts_over_0_5_m']} starts over 0.5 m; rpe over 10 m worst "
+      f"{summary['rpe_10m_worst_m']} m; outputs in {out}", file=sys.stderr)
+print(json.dumps(summary))
+PY

@@ -108,7 +108,10 @@ corpus="$(grep -o 'corp: [0-9]*' <<<"$last" | grep -o '[0-9]*' || echo 0)"
 findings="$(find "$BUILD/findings/$TARGET" -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' \
   -o -name 'oom-*' | wc -l)"
 tail -n 30 "$LOG" | grep -E 'ERROR|SUMMARY|Done|stat::' >&2 || true
-echo "{\"target\": \"$TARGET\", \"seconds\": $SECONDS_TO_RUN, \"executions\": ${executions:-0}," \
-  "\"coverage_edges\": ${cov:-0}, \"features\": ${ft:-0}, \"corpus\": ${corpus:-0}," \
-  "\"findings\": $findings, \"exit_code\": $rc, \"log\": \"$LOG\"}"
+python3 -c 'import json, sys
+k = ["target", "seconds", "executions", "coverage_edges", "features", "corpus", "findings",
+     "exit_code", "log"]
+v = sys.argv[1:2] + [int(x or 0) for x in sys.argv[2:9]] + sys.argv[9:]
+print(json.dumps(dict(zip(k, v))))' "$TARGET" "$SECONDS_TO_RUN" "$executions" "$cov" "$ft" \
+  "$corpus" "$findings" "$rc" "$LOG"
 ((findings == 0 && rc == 0))

@@ -3,7 +3,7 @@
 #
 #   scripts/run-graph.sh --deploy configs/deploy/pipeline.yaml --log INPUT.lcmlog --out OUTDIR \
 #       [--speed S] [--stages NAME,NAME|all] [--lcm-url URL] [--grace S] [--stop-timeout S]
-#       [--host NAME]
+#       [--host NAME] [--record-without REGEX]
 #
 # On several machines (hosts and lcm_url with ttl=1 in the deployment file), each machine runs
 # this with the same file and --host NAME; the first host records, judges and replays --log,
@@ -17,7 +17,8 @@
 #
 # --speed multiplies the log's own pace (default 1; 0 replays as fast as possible, with losses).
 #
-# Records every channel into OUTDIR/run.lcmlog, the monitor's summary into OUTDIR/monitor.json and
+# Records every channel (but those --record-without matches, e.g. 'SCAN_.*|IMU') into
+# OUTDIR/run.lcmlog, the monitor's summary into OUTDIR/monitor.json and
 # each process's output into OUTDIR/<name>.log, and its own summary (JSON line last on stdout) into
 # OUTDIR/run-graph.json. Exits 1 if a process died (it says which), 3 if the run's verdict fails
 # (the input log is damaged or empty, or the monitor -- configs/monitor.yaml -- found messages

@@ -25,7 +25,7 @@
 #include "bus.hpp"
 #include "config.hpp"
 #include "coverage.hpp"
-#include "json_escape.hpp"
+#include "json.hpp"
 #include "lcm_log.hpp"
 #include "version.hpp"
 #include "traverse/annotations_t.hpp"
@@ -228,7 +228,8 @@ int main(int argc, char** argv) {
               r.local_coverage, r.local_key_poses);
   std::printf("raw NEES (2 dof, 2 if consistent): mean %.3g, median %.3g, q95 %.3g\n", r.nees_mean,
               r.nees_median, r.nees_q95);
-  std::string levels_json = "[";
+  const auto figure = [](double v) { return traverse::json_significant(v, 6); };
+  traverse::Json levels = traverse::Json::array();
   for (const auto& f : r.levels) {
     const std::string name =
         f.level < static_cast<int>(level_names.size()) ? level_names[f.level] : "?";
@@ -237,35 +238,40 @@ int main(int argc, char** argv) {
         "%.4f m\n",
         name.c_str(), f.key_poses, static_cast<long long>(f.points), f.mean_point_error_m,
         f.mean_bound_m);
-    levels_json += std::string(levels_json.size() > 1 ? "," : "") + "{\"level\": \"" +
-                   traverse::json_escape(name) +
-                   "\", \"key_poses\": " + std::to_string(f.key_poses) +
-                   ", \"points\": " + std::to_string(f.points) +
-                   ", \"mean_point_error_m\": " + num(f.mean_point_error_m) +
-                   ", \"mean_bound_m\": " + num(f.mean_bound_m) + "}";
+    levels.push_back({{"level", name},
+                      {"key_poses", f.key_poses},
+                      {"points", f.points},
+                      {"mean_point_error_m", figure(f.mean_point_error_m)},
+                      {"mean_bound_m", figure(f.mean_bound_m)}});
   }
-  levels_json += "]";
-  auto json_list = [](const std::vector<double>& v) {
-    std::string out = "[";
-    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + num(v[i]);
-    return out + "]";
+  const auto figures = [&](const std::vector<double>& v) {
+    traverse::Json out = traverse::Json::array();
+    for (double x : v) out.push_back(figure(x));
+    return out;
   };
-  std::printf(
-      "{\"log\": \"%s\", \"events\": %lld, \"key_poses\": %d, \"coverage\": %s, "
-      "\"local_coverage\": "
-      "%s, \"local_key_poses\": %d, \"local_radius_m\": %s, \"position_rmse_m\": %s, "
-      "\"mean_bound_m\": %s, \"nees_mean\": %s, \"nees_median\": %s, \"nees_q95\": %s, "
-      "\"scale_by_mean\": %s, \"scale_by_q95\": %s, \"scale_by_coverage\": %s, "
-      "\"covariance_scale\": %s, \"coloured_by\": \"%s\", \"standard\": \"%s\", "
-      "\"levels\": %s, \"levels_increasing\": %s, \"nees\": %s, \"needed_scale\": %s}\n",
-      traverse::json_escape(o.log).c_str(), static_cast<long long>(events), r.key_poses,
-      num(r.coverage).c_str(), num(r.local_coverage).c_str(), r.local_key_poses,
-      num(local_radius_m).c_str(), num(r.position_rmse_m).c_str(), num(r.mean_bound_m).c_str(),
-      num(r.nees_mean).c_str(), num(r.nees_median).c_str(), num(r.nees_q95).c_str(),
-      num(r.scale_by_mean).c_str(), num(r.scale_by_q95).c_str(), num(r.scale_by_coverage).c_str(),
-      num(published_scale).c_str(), traverse::json_escape(coloured_by).c_str(),
-      traverse::json_escape(standard).c_str(), levels_json.c_str(),
-      r.levels_increasing ? "true" : "false", json_list(r.nees).c_str(),
-      json_list(r.needed_scale).c_str());
+  traverse::Json j;
+  j["log"] = o.log;
+  j["events"] = events;
+  j["key_poses"] = r.key_poses;
+  j["coverage"] = figure(r.coverage);
+  j["local_coverage"] = figure(r.local_coverage);
+  j["local_key_poses"] = r.local_key_poses;
+  j["local_radius_m"] = figure(local_radius_m);
+  j["position_rmse_m"] = figure(r.position_rmse_m);
+  j["mean_bound_m"] = figure(r.mean_bound_m);
+  j["nees_mean"] = figure(r.nees_mean);
+  j["nees_median"] = figure(r.nees_median);
+  j["nees_q95"] = figure(r.nees_q95);
+  j["scale_by_mean"] = figure(r.scale_by_mean);
+  j["scale_by_q95"] = figure(r.scale_by_q95);
+  j["scale_by_coverage"] = figure(r.scale_by_coverage);
+  j["covariance_scale"] = figure(published_scale);
+  j["coloured_by"] = coloured_by;
+  j["standard"] = standard;
+  j["levels"] = std::move(levels);
+  j["levels_increasing"] = r.levels_increasing;
+  j["nees"] = figures(r.nees);
+  j["needed_scale"] = figures(r.needed_scale);
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return r.key_poses > 0 ? 0 : 1;
 }

@@ -130,6 +130,7 @@ void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odo
   const auto [ca, cb] = frontend_covariances();
   const int from = drift_model_ ? key_vertex(key - 1) + 1 : key_vertex(key - 1);
   const int to = drift_model_ ? key_vertex(key) + 1 : key_vertex(key);
+  Edge step;       // between the key poses, as published
   if (odometry) {  // the odometry's step instead of the frontend's
     Edge edge;
     edge.from = from;
@@ -138,13 +139,17 @@ void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odo
     edge.information = odometry->covariance.inverse();
     graph_.edges.push_back(edge);
     edge_kinds_.push_back(drift_model_ ? EdgeKind::kFrontendDrift : EdgeKind::kFrontend);
+    step = edge;
   } else if (!drift_model_) {
     graph_.edges.push_back(motion_edge(from, to, a, b, ca, cb));
     edge_kinds_.push_back(EdgeKind::kFrontend);
+    step = graph_.edges.back();
   } else {
     graph_.edges.push_back(drift_edge(from, to, a, b, ca, cb, config_.frontend_drift_length_m));
     edge_kinds_.push_back(EdgeKind::kFrontendDrift);
+    step = key_step_edge(from, to, a, b, ca, cb, config_.frontend_drift_length_m);
   }
+  key_edges_.push_back({key - 1, key, EdgeKind::kFrontend, step.T_from_to, step.information});
   if (!drift_model_) return;
   const int m_b = to;
   Edge pose;
@@ -203,9 +208,14 @@ void Backend::add_key_pose(const PlanarScan& scan) {
       const auto [ca, cb] = frontend_covariances();
       odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
       if (odometry && odometry->frontend_rejected) {
+        const Pose2& T_world_prev = key_poses_[prev].T_world_base;
         const MatchResult mo =
-            link_matcher_.match(reference, query, key_poses_[prev].T_world_base * odometry->motion);
-        if (mo.valid && (!m.valid || mo.raw_response > m.raw_response)) {
+            link_matcher_.match(reference, query, T_world_prev * odometry->motion);
+        if (mo.valid && scans_side_with_odometry(
+                            *odometry, motion, ca + cb, between(T_world_prev, mo.T_world_query),
+                            rotate_covariance(mo.covariance, T_world_prev.rotation().transpose()),
+                            mo.raw_response, m.valid ? m.raw_response : 0.0,
+                            config_.odometry.max_frontend_chi2)) {
           m = mo;
           motion = odometry->motion;
           ++counters_.frontend_steps_replaced;
@@ -251,6 +261,7 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     if (linked) {
       graph_.edges.push_back(link);
       edge_kinds_.push_back(EdgeKind::kLink);
+      key_edges_.push_back({prev, index, EdgeKind::kLink, link.T_from_to, link.information});
     }
     if (frontend) add_frontend_edges(index, odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
@@ -283,6 +294,8 @@ void Backend::add_closure(LoopClosure closure) {
     graph_.edges.push_back(edge);
   }
   edge_kinds_.push_back(EdgeKind::kClosure);
+  key_edges_.push_back(
+      {closure.from, closure.to, EdgeKind::kClosure, edge.T_from_to, edge.information});
   closures_.push_back(closure);
 }
 

@@ -146,6 +146,17 @@ enum class EdgeKind {
   kClosure,        // a loop closure
 };
 
+// An edge between two key poses (key pose indices, not graph vertices), as published
+// (backend_node.hpp): links and closures as in the graph; the frontend's edges of a key step (with
+// the drift model: the drifting frontend's step and its pose edge) as one edge of the frontend's
+// motion (frontend_chain.hpp, key_step_edge).
+struct KeyEdge {
+  int from = 0, to = 0;                                       // key pose indices
+  EdgeKind kind = EdgeKind::kLink;                            // kLink, kFrontend or kClosure
+  Pose2 T_from_to;                                            // pose of `to` in the frame of `from`
+  Eigen::Matrix3d information = Eigen::Matrix3d::Identity();  // 1/m^2, 1/(m rad), 1/rad^2
+};
+
 struct BackendUpdate {
   int optimisation = 0;                   // 1 for the first optimisation, +1 each
   std::vector<int> new_key_poses;         // key pose indices added since the previous update
@@ -202,6 +213,8 @@ class Backend {
   }
   // The kind of each edge of graph().edges, in the same order.
   const std::vector<EdgeKind>& edge_kinds() const { return edge_kinds_; }
+  // The graph's edges between key poses only, in the order they were added (KeyEdge).
+  const std::vector<KeyEdge>& key_edges() const { return key_edges_; }
   const std::vector<KeyPose>& key_poses() const { return key_poses_; }
   const ScanStore& scans() const { return scans_; }
   const std::vector<LoopClosure>& closures() const { return closures_; }
@@ -248,6 +261,7 @@ class Backend {
 
   PoseGraph graph_;
   std::vector<EdgeKind> edge_kinds_;  // parallel to graph_.edges
+  std::vector<KeyEdge> key_edges_;
   std::vector<KeyPose> key_poses_;
   PreparedPose last_key_;  // prepared pose of the last key pose
   ScanStore scans_;

@@ -89,11 +89,10 @@ bool BackendNode::changed(int i) const {
   return false;
 }
 
-// The edges appended since the last call. The graph has no edge kinds: an edge between
-// non-consecutive key poses is a loop closure, the second edge of a consecutive pair is the
-// frontend's motion (backend.cpp adds the link first).
+// The key-pose edges appended since the last call (Backend::key_edges: the drift model's
+// auxiliary vertices are not published).
 void BackendNode::publish_new_edges(int32_t optimisation) {
-  const std::vector<Edge>& edges = backend_.graph().edges;
+  const std::vector<KeyEdge>& edges = backend_.key_edges();
   const std::vector<KeyPose>& keys = backend_.key_poses();
   // 125 bytes per edge: at most 500 keep a part under 64 KB.
   const std::size_t per = static_cast<std::size_t>(std::min(config_.max_poses_per_message, 500));
@@ -109,17 +108,15 @@ void BackendNode::publish_new_edges(int32_t optimisation) {
     msg.first_index = static_cast<int32_t>(first + part * per);
     for (std::size_t k = msg.first_index; k < std::min(edges.size(), first + (part + 1) * per);
          ++k) {
-      const Edge& e = edges[k];
+      const KeyEdge& e = edges[k];
       pose_graph_edge_t m{};
       m.utime = keys[e.to].utime;
       m.index = static_cast<int32_t>(k);
       m.from_id = e.from;
       m.to_id = e.to;
-      const bool consecutive = e.to == e.from + 1;
-      const bool repeated = k > 0 && edges[k - 1].from == e.from && edges[k - 1].to == e.to;
-      m.kind = !consecutive ? pose_graph_edge_t::KIND_LOOP_CLOSURE
-               : repeated   ? pose_graph_edge_t::KIND_FRONTEND
-                            : pose_graph_edge_t::KIND_LINK;
+      m.kind = e.kind == EdgeKind::kClosure    ? pose_graph_edge_t::KIND_LOOP_CLOSURE
+               : e.kind == EdgeKind::kFrontend ? pose_graph_edge_t::KIND_FRONTEND
+                                               : pose_graph_edge_t::KIND_LINK;
       m.x = e.T_from_to.x();
       m.y = e.T_from_to.y();
       m.theta = e.T_from_to.theta();

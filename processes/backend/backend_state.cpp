@@ -7,7 +7,7 @@
 namespace traverse::backend {
 namespace {
 
-const std::string kMagic = "TRVBKG01";  // graph.state, version 1
+const std::string kMagic = "TRVBKG02";  // graph.state, version 2 (closures without second_peak)
 // Bounds on what a snapshot may claim, so a damaged count cannot allocate without end.
 constexpr uint64_t kMaxItems = 50'000'000;
 
@@ -85,7 +85,6 @@ std::string BackendStateStore::snapshot(const Backend& b) const {
     w.put(c.T_from_to);
     put(w, c.covariance);
     w.put(c.response);
-    w.put(c.second_peak);
     w.put<int32_t>(c.candidates_tried);
     w.put(c.chi2_increase);
   }
@@ -137,8 +136,7 @@ std::optional<ResumedState> BackendStateStore::resume(Backend& b) {
   b.closures_.resize(n);
   for (LoopClosure& c : b.closures_) {
     if (!r.get(i0) || !r.get(i1) || !r.get(c.T_from_to) || !get(r, c.covariance) ||
-        !r.get(c.response) || !r.get(c.second_peak) || !r.get(c.candidates_tried) ||
-        !r.get(c.chi2_increase))
+        !r.get(c.response) || !r.get(c.candidates_tried) || !r.get(c.chi2_increase))
       throw damaged();
     c.from = i0;
     c.to = i1;

@@ -11,29 +11,24 @@
 namespace traverse::backend {
 namespace {
 
-// The lookup table of section III-B: cell (ix, iy) covers [origin + ix res, origin + (ix + 1) res)
-// (and likewise in y) and holds exp(-d^2 / 2 sigma^2) of the nearest reference point.
+// The lookup table of section III-B over the cells [i0, i0 + width) x [j0, j0 + height) of a grid
+// with its origin at `origin`: cell (i, j) covers [origin + i res, origin + (i + 1) res) (and
+// likewise in y) and holds exp(-d^2 / 2 sigma^2) of the nearest reference point. Only the cells
+// a query can reach are held: a table over the reference points' whole extent spent most of a
+// link's time (its block bounds) on cells no query point lands in.
 class LookupTable {
  public:
   LookupTable(const std::vector<Eigen::Vector2d>& points, double resolution, double sigma,
-              double margin)
-      : resolution_(resolution) {
-    Eigen::Vector2d lo = points.front(), hi = points.front();
-    for (const auto& p : points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    origin_ = lo - Eigen::Vector2d::Constant(margin);
-    scores_ = correlative::ScoreTable(
-        static_cast<int>(std::ceil((hi.x() - lo.x() + 2 * margin) / resolution)) + 1,
-        static_cast<int>(std::ceil((hi.y() - lo.y() + 2 * margin) / resolution)) + 1);
+              const Eigen::Vector2d& origin, int i0, int j0, int width, int height)
+      : resolution_(resolution), origin_(origin), i0_(i0), j0_(j0), scores_(width, height) {
     const int radius = static_cast<int>(std::ceil(3.0 * sigma / resolution));
     stamp_all(points, radius, sigma);
   }
 
+  // The cell of a point, as indices into scores().
   std::pair<int, int> index(const Eigen::Vector2d& p) const {
     const Eigen::Vector2d c = (p - origin_) / resolution_;
-    return {static_cast<int>(std::floor(c.x())), static_cast<int>(std::floor(c.y()))};
+    return {static_cast<int>(std::floor(c.x())) - i0_, static_cast<int>(std::floor(c.y())) - j0_};
   }
   const correlative::ScoreTable& scores() const { return scores_; }
 
@@ -52,6 +47,10 @@ class LookupTable {
     }
     for (const auto& p : points) {
       const auto [cx, cy] = index(p);
+      if (cx < -radius || cy < -radius || cx > scores_.width() + radius ||
+          cy > scores_.height() + radius) {
+        continue;
+      }
       for (int dy = -radius; dy <= radius; ++dy) {
         for (int dx = -radius; dx <= radius; ++dx) {
           if (!scores_.inside(cx + dx, cy + dy)) continue;
@@ -64,6 +63,7 @@ class LookupTable {
 
   double resolution_;
   Eigen::Vector2d origin_;
+  int i0_, j0_;
   correlative::ScoreTable scores_;
 };
 
@@ -102,8 +102,8 @@ CorrelativeMatcher::CorrelativeMatcher(CorrelativeMatcherConfig config)
 
 MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& reference_all,
                                       const std::vector<Eigen::Vector2d>& query_all,
-                                      const Pose2& T_world_guess,
-                                      double second_peak_exclusion_m) const {
+                                      const Pose2& T_world_guess, double second_peak_exclusion_m,
+                                      double second_peak_min_share) const {
   MatchResult result;
   if (reference_all.empty() || query_all.empty()) return result;
   if (!Eigen::Vector3d(T_world_guess.x(), T_world_guess.y(), T_world_guess.theta()).allFinite()) {
@@ -134,13 +134,35 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
   reach += std::sqrt(2.0) * (W + c.coarse_factor) * res + 2.0 * margin;
   if (std::pow(2.0 * reach / res, 2) > kMaxTableCells) return result;
   std::vector<Eigen::Vector2d> reference_world;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   for (const Eigen::Vector2d& p : reference_all) {
     if (p.allFinite() && (p - T_world_guess.translation()).cwiseAbs().maxCoeff() <= reach) {
       reference_world.push_back(p);
+      lo = lo.cwiseMin(p);
     }
   }
   if (reference_world.empty()) return result;
-  const LookupTable table(reference_world, res, c.kernel_sigma_m, margin);
+  // The grid's origin as a table over all these points would have it, so that the scores do not
+  // depend on how much of it is held; then the cells any query point reaches at some pose of the
+  // search window (its own arc over the headings, the translations and the coarse blocks beyond
+  // them, a cell of rounding), with the kernel's margin.
+  const Eigen::Vector2d origin = lo - Eigen::Vector2d::Constant(margin);
+  Eigen::Vector2d box_lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d box_hi = -box_lo;
+  const double turn = A * step, shift = (W + c.coarse_factor + 1) * res + margin;
+  for (const Eigen::Vector2d& q : query) {
+    const Eigen::Vector2d p = T_world_guess * q;
+    const double e = q.norm() * turn + shift;
+    box_lo = box_lo.cwiseMin(p - Eigen::Vector2d::Constant(e));
+    box_hi = box_hi.cwiseMax(p + Eigen::Vector2d::Constant(e));
+  }
+  const auto cell = [&](double v, double o) { return static_cast<int>(std::floor((v - o) / res)); };
+  const int i0 = std::max(0, cell(box_lo.x(), origin.x()));
+  const int j0 = std::max(0, cell(box_lo.y(), origin.y()));
+  const int i1 = cell(box_hi.x(), origin.x()), j1 = cell(box_hi.y(), origin.y());
+  if (i1 < i0 || j1 < j0) return result;
+  const LookupTable table(reference_world, res, c.kernel_sigma_m, origin, i0, j0, i1 - i0 + 1,
+                          j1 - j0 + 1);
   const correlative::BlockBound coarse(table.scores(), c.coarse_factor);
   const correlative::RotatedScans scans(query, T_world_guess, A, step,
                                         [&](const Eigen::Vector2d& p) { return table.index(p); });
@@ -198,10 +220,11 @@ MatchResult CorrelativeMatcher::match(const std::vector<Eigen::Vector2d>& refere
       }
       return sum / n;
     };
+    const double floor = second_peak_min_share * result.raw_response;
     const auto second = correlative::branch_and_bound<double>(
-        scans, table.scores(), coarse, W, {0.0, A, 0, 0}, 0.0, far_raw, no_visit);
+        scans, table.scores(), coarse, W, {floor, A, 0, 0}, 0.0, far_raw, no_visit);
     result.evaluations += static_cast<long>(second.scored);
-    result.second_peak_response = second.best.score;
+    result.second_peak_response = second.best.score > floor ? second.best.score : 0.0;
   }
 
   // Covariance from the spread of the response around the best pose (section III-D).

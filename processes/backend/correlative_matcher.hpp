@@ -66,8 +66,9 @@ struct MatchResult {
   Pose2 T_world_query;        // best pose of the query scan
   double response = 0.0;      // penalised response of the best pose [0..1]
   double raw_response = 0.0;  // its response without the penalty [0..1]
-  // Best raw response among poses farther than `exclusion_m` from the best (only when asked);
-  // a value close to raw_response means the scene is ambiguous (repeated rooms).
+  // Best raw response among poses farther than `exclusion_m` from the best (only when asked, and
+  // only when above the asked share of raw_response: 0 otherwise); a value close to
+  // raw_response means the scene is ambiguous (repeated rooms).
   double second_peak_response = 0.0;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // world frame, (x, y, theta):
                                                              // m^2, m rad, rad^2
@@ -81,10 +82,13 @@ class CorrelativeMatcher {
 
   // Matches query points (query frame) against reference points (world frame) around the guess
   // T_world_guess. If second_peak_exclusion_m > 0, also finds the best raw response outside that
-  // distance from the best translation (the ambiguity check of the loop closer).
+  // distance from the best translation (the ambiguity check of the loop closer), if it exceeds
+  // second_peak_min_share times the best's raw response: the search skips every block bounded
+  // below that, which is most of a wide window (a loop closer that rejects a second peak above a
+  // share of the peak needs no lower one).
   MatchResult match(const std::vector<Eigen::Vector2d>& reference_world,
                     const std::vector<Eigen::Vector2d>& query, const Pose2& T_world_guess,
-                    double second_peak_exclusion_m = 0.0) const;
+                    double second_peak_exclusion_m = 0.0, double second_peak_min_share = 0.0) const;
 
   const CorrelativeMatcherConfig& config() const { return config_; }
 

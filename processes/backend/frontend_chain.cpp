@@ -50,4 +50,14 @@ Edge motion_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
   return edge;
 }
 
+Edge key_step_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
+                   const Eigen::Matrix3d& ca, const Eigen::Matrix3d& cb, double drift_length_m) {
+  Edge edge = motion_edge(from, to, a, b, ca, cb);
+  if (drift_length_m > 0.0) {
+    const Edge drift = drift_edge(from, to, a, b, ca, cb, drift_length_m);
+    edge.information = (edge.information.inverse() + drift.information.inverse()).inverse();
+  }
+  return edge;
+}
+
 }  // namespace traverse::backend

@@ -45,4 +45,12 @@ Edge drift_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
 Edge motion_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
                  const Eigen::Matrix3d& ca, const Eigen::Matrix3d& cb);
 
+// The frontend's motion from a to b as one edge between the key poses, with the covariance the
+// drift model gives that relative pose: both poses' errors and the map's drift over the step
+// (drift_length_m 0: no drift). What a consumer of the key poses alone gets (the published edges,
+// backend_node.hpp): a chain of such edges leaves out that consecutive steps share a pose's
+// error, so over many steps it allows more than the model.
+Edge key_step_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
+                   const Eigen::Matrix3d& ca, const Eigen::Matrix3d& cb, double drift_length_m);
+
 }  // namespace traverse::backend

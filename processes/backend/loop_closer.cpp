@@ -45,8 +45,8 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   const std::vector<Eigen::Vector2d> query = scans.points_d(current);
 
   // 1.-2. Coarse search over the wide window, with the ambiguity check.
-  const MatchResult coarse =
-      coarse_.match(reference, query, poses[current], config_.ambiguity_exclusion_m);
+  const MatchResult coarse = coarse_.match(
+      reference, query, poses[current], config_.ambiguity_exclusion_m, config_.max_ambiguity_ratio);
   if (!coarse.valid || coarse.raw_response < config_.min_coarse_response) {
     ++counters_.rejected_response;
     return std::nullopt;
@@ -105,7 +105,6 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
   // of the `to` pose.
   closure.covariance = rotate_covariance(covariance, T_world_current.rotation().transpose());
   closure.response = fine.raw_response;
-  closure.second_peak = ambiguity;
   return closure;
 }
 

@@ -113,7 +113,6 @@ struct LoopClosure {
   // pose graph's edge error is expressed: m^2, m rad, rad^2.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   double response = 0.0;     // fine raw response [0..1]
-  double second_peak = 0.0;  // coarse ambiguity ratio (second peak / peak)
   int candidates_tried = 0;  // candidates of the episode
   // [unitless] how much the pose graph's chi2 grew when the closure was added (the backend's
   // trial optimisation); 0 when not checked.

@@ -21,6 +21,23 @@ std::optional<std::string> validate(const OdometryCheckConfig& c) {
   return check.problem();
 }
 
+double step_chi2(const Pose2& a, const Pose2& b, const Eigen::Matrix3d& S) {
+  const Eigen::Vector3d e(a.x() - b.x(), a.y() - b.y(), wrap_angle(a.theta() - b.theta()));
+  return e.dot(S.ldlt().solve(e));
+}
+
+bool scans_side_with_odometry(const OdometryStep& odometry, const Pose2& frontend_motion,
+                              const Eigen::Matrix3d& frontend_covariance, const Pose2& match,
+                              const Eigen::Matrix3d& match_covariance, double match_raw_response,
+                              double frontend_match_raw_response, double gate_chi2) {
+  if (!(match_raw_response > frontend_match_raw_response)) return false;
+  const double to_odometry =
+      step_chi2(match, odometry.motion, odometry.covariance + match_covariance);
+  const double to_frontend =
+      step_chi2(match, frontend_motion, frontend_covariance + match_covariance);
+  return to_odometry <= gate_chi2 && !(to_frontend <= gate_chi2);
+}
+
 void OdometryCheck::add(int64_t utime, const Pose2& T_odom_base) {
   if (!config_.enabled) return;
   if (!readings_.empty() && utime <= readings_.back().first) {
@@ -67,11 +84,8 @@ std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utim
   const double sth = config_.min_sigma_theta_rad + config_.sigma_theta_per_m * d +
                      config_.sigma_theta_per_rad * std::abs(step.motion.theta());
   step.covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-  const Eigen::Vector3d e(frontend_motion.x() - step.motion.x(),
-                          frontend_motion.y() - step.motion.y(),
-                          wrap_angle(frontend_motion.theta() - step.motion.theta()));
-  const Eigen::Matrix3d S = step.covariance + frontend_covariance;
-  step.frontend_chi2 = e.dot(S.ldlt().solve(e));
+  step.frontend_chi2 =
+      step_chi2(frontend_motion, step.motion, step.covariance + frontend_covariance);
   step.frontend_rejected = !(step.frontend_chi2 <= config_.max_frontend_chi2);
   if (step.frontend_rejected) ++counters_.steps_contradicted;
   return step;

@@ -1,26 +1,10 @@
 #include "summary.hpp"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
-#include "json_escape.hpp"
+#include "json.hpp"
 
 namespace traverse::carmen {
-namespace {
-
-std::string list(const std::vector<int64_t>& v) { return fmt::format("[{}]", fmt::join(v, ",")); }
-
-std::string counts(const std::map<std::string, int64_t>& m) {
-  std::string out = "{";
-  for (const auto& [type, n] : m) {
-    out += (out.size() > 1 ? ",\"" : "\"") + json_escape(type) + "\":" + std::to_string(n);
-  }
-  return out + "}";
-}
-
-std::string quoted(const std::string& s) { return fmt::format("\"{}\"", json_escape(s)); }
-
-}  // namespace
 
 std::string survey_warnings(const Summary& s, const CarmenConfig& cfg, OdometrySource source) {
   std::string out;
@@ -91,46 +75,44 @@ std::string summary_text(const Summary& s, const RunFacts& run) {
 }
 
 std::string summary_json(const Summary& s, const RunFacts& run, const CarmenConfig& cfg) {
-  std::string j =
-      "{\"scans\":" + std::to_string(run.scans_published) +
-      ",\"reference_poses\":" + std::to_string(run.poses_published) +
-      ",\"odometry\":" + std::to_string(run.odometry_published) +
-      ",\"lines\":" + std::to_string(s.lines) + ",\"scans_by_type\":" + counts(s.scans_by_type) +
-      ",\"odometry_lines\":" + std::to_string(s.odometry) +
-      ",\"skipped_by_type\":" + counts(s.skipped_by_type) +
-      ",\"malformed_count\":" + std::to_string(s.malformed_count) +
-      ",\"malformed_lines\":" + list(s.malformed_lines) + ",\"malformed_lines_capped\":" +
-      (s.malformed_count > static_cast<int64_t>(s.malformed_lines.size()) ? "true" : "false");
-  j += ",\"timestamps\":" + quoted(clock_name(s.time.clock)) +
-       ",\"timestamps_fault\":" + quoted(s.time.ipc_fault) +
-       ",\"logger_timestamps_fault\":" + quoted(s.time.logger_fault);
-  j += ",\"backwards_timestamps\":" + std::to_string(s.backwards_count) +
-       ",\"backwards_lines\":" + list(s.backwards_lines) +
-       ",\"max_backstep_us\":" + std::to_string(s.max_backstep_us);
-  j += fmt::format(
-      ",\"timestamp_quantum_s\":{:g},\"quantised_timestamps\":{},\"restamped_from_logger\":{},"
-      "\"restamped_nominal\":{},\"nominal_scan_period_s\":{:g}",
-      s.max_quantum_s, s.quantised_count, s.restamped_logger, s.restamped_nominal,
-      cfg.nominal_scan_period_s);
-  if (s.no_return) {
-    j += fmt::format(",\"no_return_code_m\":{:.3f},\"no_return_beams\":{}", s.no_return->code_m,
-                     s.no_return->beams);
-  } else {
-    j += ",\"no_return_code_m\":null,\"no_return_beams\":0";
-  }
-  j += fmt::format(",\"max_beams_in_scan\":{},\"scans_thinned\":{}", s.max_beams_in_scan,
-                   run.scans_thinned);
-  j += ",\"odometry_source\":" + quoted(odometry_source_name(run.odometry_source)) +
-       ",\"odometry_reanchors\":" + std::to_string(s.odometry_reanchors) +
-       ",\"odometry_out_of_order\":" + std::to_string(s.odometry_out_of_order) +
-       ",\"odometry_behind_scans\":" + std::to_string(run.odometry_behind_scans) +
-       ",\"odometry_velocity\":" + (s.odometry_velocity ? "true" : "false");
-  j += ",\"first_utime\":" + std::to_string(run.first_utime) +
-       ",\"last_utime\":" + std::to_string(run.last_utime);
-  j += fmt::format(",\"wall_s\":{:.3f}", run.wall_s);
-  j += std::string(",\"interrupted\":") + (run.interrupted ? "true" : "false") +
-       ",\"input_error\":" + quoted(s.input_error) + ",\"out\":" + quoted(run.out_path) + "}";
-  return j;
+  Json j;
+  j["scans"] = run.scans_published;
+  j["reference_poses"] = run.poses_published;
+  j["odometry"] = run.odometry_published;
+  j["lines"] = s.lines;
+  j["scans_by_type"] = Json(s.scans_by_type);
+  j["odometry_lines"] = s.odometry;
+  j["skipped_by_type"] = Json(s.skipped_by_type);
+  j["malformed_count"] = s.malformed_count;
+  j["malformed_lines"] = s.malformed_lines;
+  j["malformed_lines_capped"] = s.malformed_count > static_cast<int64_t>(s.malformed_lines.size());
+  j["timestamps"] = clock_name(s.time.clock);
+  j["timestamps_fault"] = s.time.ipc_fault;
+  j["logger_timestamps_fault"] = s.time.logger_fault;
+  j["backwards_timestamps"] = s.backwards_count;
+  j["backwards_lines"] = s.backwards_lines;
+  j["max_backstep_us"] = s.max_backstep_us;
+  j["timestamp_quantum_s"] = json_significant(s.max_quantum_s, 6);
+  j["quantised_timestamps"] = s.quantised_count;
+  j["restamped_from_logger"] = s.restamped_logger;
+  j["restamped_nominal"] = s.restamped_nominal;
+  j["nominal_scan_period_s"] = json_significant(cfg.nominal_scan_period_s, 6);
+  j["no_return_code_m"] = s.no_return ? json_fixed(s.no_return->code_m, 3) : Json();
+  j["no_return_beams"] = s.no_return ? s.no_return->beams : 0;
+  j["max_beams_in_scan"] = s.max_beams_in_scan;
+  j["scans_thinned"] = run.scans_thinned;
+  j["odometry_source"] = odometry_source_name(run.odometry_source);
+  j["odometry_reanchors"] = s.odometry_reanchors;
+  j["odometry_out_of_order"] = s.odometry_out_of_order;
+  j["odometry_behind_scans"] = run.odometry_behind_scans;
+  j["odometry_velocity"] = s.odometry_velocity;
+  j["first_utime"] = run.first_utime;
+  j["last_utime"] = run.last_utime;
+  j["wall_s"] = json_fixed(run.wall_s, 3);
+  j["interrupted"] = run.interrupted;
+  j["input_error"] = s.input_error;
+  j["out"] = run.out_path;
+  return json_line(j);
 }
 
 }  // namespace traverse::carmen

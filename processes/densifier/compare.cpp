@@ -8,10 +8,10 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 
 #include "config.hpp"
 #include "densifier.hpp"
+#include "json.hpp"
 #include "rig.hpp"
 #include "rng.hpp"
 #include "trajectory.hpp"
@@ -50,13 +50,14 @@ Errors errors(const std::vector<td::StampedPose>& est, const std::vector<Pose2>&
   return e;
 }
 
-std::string json(const Errors& e) {
-  char b[256];
-  std::snprintf(b, sizeof b,
-                "{\"rmse_m\": %.6f, \"max_m\": %.6f, \"heading_rmse_rad\": %.6f, "
-                "\"still_rmse_m\": %.6f, \"still_max_m\": %.6f}",
-                e.rmse_m, e.max_m, e.heading_rmse_rad, e.still_rmse_m, e.still_max_m);
-  return b;
+traverse::Json json(const Errors& e) {
+  traverse::Json j;
+  j["rmse_m"] = traverse::json_fixed(e.rmse_m, 6);
+  j["max_m"] = traverse::json_fixed(e.max_m, 6);
+  j["heading_rmse_rad"] = traverse::json_fixed(e.heading_rmse_rad, 6);
+  j["still_rmse_m"] = traverse::json_fixed(e.still_rmse_m, 6);
+  j["still_max_m"] = traverse::json_fixed(e.still_max_m, 6);
+  return j;
 }
 
 }  // namespace
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
   traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
-  std::ostringstream out;
+  traverse::Json out_routes = traverse::Json::array();
   for (const std::string& file : routes) {
     ts::RouteSpec route;
     try {
@@ -112,7 +113,8 @@ int main(int argc, char** argv) {
                         T * Pose2(rng.normal(2e-3), rng.normal(2e-3), rng.normal(5e-4))});
       }
     }
-    out << (out.tellp() > 0 ? ", " : "") << "{\"route\": \"" << file << "\"";
+    traverse::Json entry;
+    entry["route"] = file;
     for (const char* mode : {"paper", "rigid"}) {
       td::DensifierConfig cfg;
       cfg.mode = mode;
@@ -125,11 +127,13 @@ int main(int argc, char** argv) {
           "still: RMSE %.2f mm, max %.2f mm\n",
           file.c_str(), mode, 1e3 * e.rmse_m, 1e3 * e.max_m, 1e3 * e.heading_rmse_rad,
           1e3 * e.still_rmse_m, 1e3 * e.still_max_m);
-      out << ", \"" << mode << "\": " << json(e);
+      entry[mode] = json(e);
     }
-    out << "}";
+    out_routes.push_back(std::move(entry));
   }
-  std::printf("{\"seed\": %llu, \"routes\": [%s]}\n", static_cast<unsigned long long>(seed),
-              out.str().c_str());
+  traverse::Json summary;
+  summary["seed"] = seed;
+  summary["routes"] = std::move(out_routes);
+  std::printf("%s\n", traverse::json_line(summary).c_str());
   return 0;
 }

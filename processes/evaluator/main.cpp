@@ -23,6 +23,9 @@
 namespace {
 
 namespace ev = traverse::evaluator;
+using traverse::Json;
+using traverse::json_fixed;
+using traverse::json_line;
 namespace fs = std::filesystem;
 
 struct Options {
@@ -70,7 +73,7 @@ void add_options(CLI::App& app, Options& opt) {
 
 // errors.csv and errors.png under --out, their paths (or why there is no plot) in the JSON.
 bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
-                   const ev::ClosureEvaluation& closures, ev::JsonLine& json) {
+                   const ev::ClosureEvaluation& closures, Json& json) {
   std::error_code ec;
   fs::create_directories(opt.out, ec);
   const std::string closures_csv = (fs::path(opt.out) / "closures.csv").string();
@@ -78,16 +81,17 @@ bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
     spdlog::error("traverse-evaluator: cannot write {}", closures_csv);
     return false;
   }
-  json.add("closures_csv", closures_csv);
+  json["closures_csv"] = closures_csv;
   const std::string csv = (fs::path(opt.out) / "errors.csv").string();
   const std::string png = (fs::path(opt.out) / "errors.png").string();
   if (!ev::write_errors_csv(evaluation, csv)) {
     spdlog::error("traverse-evaluator: cannot write {}", csv);
     return false;
   }
-  json.add("errors_csv", csv);
+  json["errors_csv"] = csv;
   if (evaluation.matched == 0) {
-    json.add_null("errors_png").add("plot_note", "nothing matched, nothing to plot");
+    json["errors_png"] = nullptr;
+    json["plot_note"] = "nothing matched, nothing to plot";
     return true;
   }
   const double rmse_m = evaluation.position_m.rmse;
@@ -100,44 +104,41 @@ bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
       std::string(TRAVERSE_SOURCE_DIR) + "/scripts/plot_errors.py", csv, png, title);
   if (plot_problem) {
     spdlog::warn("traverse-evaluator: {}", *plot_problem);
-    json.add_null("errors_png").add("plot_note", *plot_problem);
+    json["errors_png"] = nullptr;
+    json["plot_note"] = *plot_problem;
   } else {
-    json.add("errors_png", png);
+    json["errors_png"] = png;
   }
   return true;
 }
 
 // The JSON fields every mode reports about the estimate channel and the log it was read from.
 void add_input_facts(const Options& opt, const ev::PoseCollector& collector, bool offline,
-                     const ev::PoseCollector::LogSummary& log_summary, ev::JsonLine& json) {
+                     const ev::PoseCollector::LogSummary& log_summary, Json& json) {
   const std::string type = ev::estimate_type_name(collector.estimate_type());
-  json.add("estimate_channel", opt.estimate);
-  if (type.empty()) {
-    json.add_null("estimate_type");
-  } else {
-    json.add("estimate_type", type);
-  }
-  json.add_int("non_finite_poses", static_cast<long long>(collector.non_finite_poses()))
-      .add_int("decode_failures", static_cast<long long>(collector.decode_failures()))
-      .add_int("mixed_type_messages", static_cast<long long>(collector.mixed_type_messages()));
+  json["estimate_channel"] = opt.estimate;
+  json["estimate_type"] = type.empty() ? Json() : Json(type);
+  json["non_finite_poses"] = collector.non_finite_poses();
+  json["decode_failures"] = collector.decode_failures();
+  json["mixed_type_messages"] = collector.mixed_type_messages();
   if (offline) {
-    json.add("log", opt.log)
-        .add_int("log_damaged_records", static_cast<long long>(log_summary.damaged_records));
+    json["log"] = opt.log;
+    json["log_damaged_records"] = log_summary.damaged_records;
   }
 }
 
 // --relations: the estimate scored by the relations; exit 1 when the figures are refused.
 int score_relations(const Options& opt, const ev::EvaluatorConfig& cfg,
-                    const ev::RelationsFile& file, const ev::Trajectory& estimate,
-                    ev::JsonLine& json) {
+                    const ev::RelationsFile& file, const ev::Trajectory& estimate, Json& json) {
   const ev::RelationsEvaluation r = ev::evaluate_relations(
       estimate, file.relations, {cfg.relation_time_tolerance_us, cfg.min_reference_share});
-  json.add("mode", "relations").add("relations_file", opt.relations);
+  json["mode"] = "relations";
+  json["relations_file"] = opt.relations;
   ev::add_relations(r, json);
-  json.add("min_reference_share", cfg.min_reference_share, 3)
-      .add_int("relation_time_tolerance_us", static_cast<long long>(cfg.relation_time_tolerance_us))
-      .add_int("relations_malformed_lines", static_cast<long long>(file.malformed_count))
-      .add_int("estimate_poses", static_cast<long long>(estimate.size()));
+  json["min_reference_share"] = json_fixed(cfg.min_reference_share, 3);
+  json["relation_time_tolerance_us"] = cfg.relation_time_tolerance_us;
+  json["relations_malformed_lines"] = file.malformed_count;
+  json["estimate_poses"] = estimate.size();
   if (r.refused) {
     spdlog::error(
         "traverse-evaluator: {} of {} relations ({:.1f} %) have a pose on {} at both scans' "
@@ -152,7 +153,7 @@ int score_relations(const Options& opt, const ev::EvaluatorConfig& cfg,
       spdlog::error("traverse-evaluator: cannot write {}", csv);
       return 1;
     }
-    json.add("relations_csv", csv);
+    json["relations_csv"] = csv;
   }
   return r.refused ? 1 : 0;
 }
@@ -229,11 +230,11 @@ int main(int argc, char** argv) {
   ev::Trajectory estimate = collector.estimate();
   if (opt.shift.size() == 3) ev::shift(estimate, opt.shift[0], opt.shift[1], opt.shift[2]);
   report_type_problems(collector, opt.estimate);
-  ev::JsonLine json;
+  Json json;
   if (!opt.relations.empty()) {
     const int rc = score_relations(opt, cfg, relations, estimate, json);
     add_input_facts(opt, collector, offline, log_summary, json);
-    std::cout << json.str() << std::endl;
+    std::cout << json_line(json) << std::endl;
     return rc;
   }
 
@@ -241,13 +242,13 @@ int main(int argc, char** argv) {
   const ev::ClosureEvaluation closures = ev::check_closures(
       collector.closures().closures(), collector.reference(), cfg.match, cfg.false_closure_sigmas);
   ev::add_evaluation(evaluation, json);
-  json.add("min_reference_share", cfg.min_reference_share, 3);
+  json["min_reference_share"] = json_fixed(cfg.min_reference_share, 3);
   ev::add_closures(closures, json);
   add_input_facts(opt, collector, offline, log_summary, json);
-  json.add("reference_channel", opt.reference)
-      .add("key_poses_channel", cfg.key_poses_channel)
-      .add_int("key_pose_revisions", static_cast<long long>(collector.key_poses().replaced()))
-      .add_int("dense_segments", static_cast<long long>(collector.dense().size()));
+  json["reference_channel"] = opt.reference;
+  json["key_poses_channel"] = cfg.key_poses_channel;
+  json["key_pose_revisions"] = collector.key_poses().replaced();
+  json["dense_segments"] = collector.dense().size();
   int rc = 0;
   if (evaluation.matched == 0) {
     spdlog::error(
@@ -263,6 +264,6 @@ int main(int argc, char** argv) {
     rc = 1;
   }
   if (!opt.out.empty() && !write_outputs(opt, evaluation, closures, json)) return 1;
-  std::cout << json.str() << std::endl;
+  std::cout << json_line(json) << std::endl;
   return rc;
 }

@@ -8,8 +8,6 @@
 #include <cstdio>
 #include <fstream>
 
-#include "json_escape.hpp"
-
 namespace traverse::evaluator {
 namespace {
 
@@ -93,119 +91,78 @@ std::optional<std::string> plot_errors(const std::string& script, const std::str
   return fmt::format("no plot: {} failed with exit code {}", script, rc);
 }
 
-JsonLine& JsonLine::add(const std::string& key, const std::string& value) {
-  fields_.emplace_back(key, fmt::format("\"{}\"", json_escape(value)));
-  return *this;
-}
-
-JsonLine& JsonLine::add(const std::string& key, double value, int decimals) {
-  if (!std::isfinite(value)) return add_null(key);
-  fields_.emplace_back(key, fmt::format("{:.{}f}", value, decimals));
-  return *this;
-}
-
-JsonLine& JsonLine::add(const std::string& key, std::optional<double> value, int decimals) {
-  return value ? add(key, *value, decimals) : add_null(key);
-}
-
-JsonLine& JsonLine::add_int(const std::string& key, long long value) {
-  fields_.emplace_back(key, std::to_string(value));
-  return *this;
-}
-
-JsonLine& JsonLine::add_bool(const std::string& key, bool value) {
-  fields_.emplace_back(key, value ? "true" : "false");
-  return *this;
-}
-
-JsonLine& JsonLine::add_null(const std::string& key) {
-  fields_.emplace_back(key, "null");
-  return *this;
-}
-
-std::string JsonLine::str() const {
-  std::string out = "{";
-  for (std::size_t i = 0; i < fields_.size(); ++i) {
-    if (i > 0) out += ", ";
-    out += fmt::format("\"{}\": {}", json_escape(fields_[i].first), fields_[i].second);
-  }
-  return out + "}";
-}
-
-void add_evaluation(const Evaluation& ev, JsonLine& json) {
+void add_evaluation(const Evaluation& ev, Json& json) {
   // With nothing matched there are no errors to report, not zero errors; with too little of the
   // reference covered, none that mean anything.
   const bool report = ev.matched > 0 && !ev.refused;
-  const auto figure = [&](double value) {
-    return report ? std::optional<double>(value) : std::nullopt;
+  const auto figure = [&](std::optional<double> value) {
+    return report ? json_fixed(value, 6) : Json();
   };
-  const auto optional = [&](std::optional<double> value) { return report ? value : std::nullopt; };
-  json.add("position_rmse_m", figure(ev.position_m.rmse))
-      .add("position_sd_m", figure(ev.position_m.sd))
-      .add("position_max_m", figure(ev.position_m.max))
-      .add("heading_rmse_deg", figure(kDegPerRad * ev.heading_rad.rmse))
-      .add("heading_sd_deg", figure(kDegPerRad * ev.heading_rad.sd))
-      .add("heading_max_deg", figure(kDegPerRad * ev.heading_rad.max))
-      .add("rpe_1m_m", optional(ev.rpe_1m.rms_m))
-      .add("rpe_10m_m", optional(ev.rpe_10m.rms_m))
-      .add_int("rpe_1m_pairs", static_cast<long long>(ev.rpe_1m.pairs))
-      .add_int("rpe_10m_pairs", static_cast<long long>(ev.rpe_10m.pairs))
-      .add("max_jump_m", figure(ev.max_jump.step_error_m))
-      .add("step_nees_median", optional(ev.step_consistency.nees_median))
-      .add("step_outside_99_fraction", optional(ev.step_consistency.outside_99_fraction))
-      .add_int("step_nees_steps", static_cast<long long>(ev.step_consistency.steps));
-  if (ev.samples.size() >= 2) {
-    const int64_t t0 = ev.samples.front().utime;
-    json.add("max_jump_time_s",
-             1e-6 * static_cast<double>(ev.samples[ev.max_jump.index].utime - t0), 3);
-  } else {
-    json.add_null("max_jump_time_s");
-  }
-  json.add_int("matched", static_cast<long long>(ev.matched))
-      .add_int("unmatched", static_cast<long long>(ev.unmatched))
-      .add_int("estimate_poses", static_cast<long long>(ev.estimate_poses))
-      .add_int("reference_poses", static_cast<long long>(ev.reference_poses))
-      .add_int("reference_covered", static_cast<long long>(ev.reference_covered))
-      .add("reference_share", ev.reference_share, 4)
-      .add_bool("refused", ev.refused)
-      .add("duration_s", ev.duration_s, 3)
-      .add("length_m", ev.length_m, 3)
-      .add("align", align_name(ev.alignment.used))
-      .add("align_x_m", ev.alignment.T_ref_est.x())
-      .add("align_y_m", ev.alignment.T_ref_est.y())
-      .add("align_theta_deg", kDegPerRad * ev.alignment.T_ref_est.theta());
+  json["position_rmse_m"] = figure(ev.position_m.rmse);
+  json["position_sd_m"] = figure(ev.position_m.sd);
+  json["position_max_m"] = figure(ev.position_m.max);
+  json["heading_rmse_deg"] = figure(kDegPerRad * ev.heading_rad.rmse);
+  json["heading_sd_deg"] = figure(kDegPerRad * ev.heading_rad.sd);
+  json["heading_max_deg"] = figure(kDegPerRad * ev.heading_rad.max);
+  json["rpe_1m_m"] = figure(ev.rpe_1m.rms_m);
+  json["rpe_10m_m"] = figure(ev.rpe_10m.rms_m);
+  json["rpe_1m_pairs"] = ev.rpe_1m.pairs;
+  json["rpe_10m_pairs"] = ev.rpe_10m.pairs;
+  json["max_jump_m"] = figure(ev.max_jump.step_error_m);
+  json["step_nees_median"] = figure(ev.step_consistency.nees_median);
+  json["step_outside_99_fraction"] = figure(ev.step_consistency.outside_99_fraction);
+  json["step_nees_steps"] = ev.step_consistency.steps;
+  json["max_jump_time_s"] =
+      ev.samples.size() >= 2
+          ? json_fixed(1e-6 * static_cast<double>(ev.samples[ev.max_jump.index].utime -
+                                                  ev.samples.front().utime),
+                       3)
+          : Json();
+  json["matched"] = ev.matched;
+  json["unmatched"] = ev.unmatched;
+  json["estimate_poses"] = ev.estimate_poses;
+  json["reference_poses"] = ev.reference_poses;
+  json["reference_covered"] = ev.reference_covered;
+  json["reference_share"] = json_fixed(ev.reference_share, 4);
+  json["refused"] = ev.refused;
+  json["duration_s"] = json_fixed(ev.duration_s, 3);
+  json["length_m"] = json_fixed(ev.length_m, 3);
+  json["align"] = align_name(ev.alignment.used);
+  json["align_x_m"] = json_fixed(ev.alignment.T_ref_est.x(), 6);
+  json["align_y_m"] = json_fixed(ev.alignment.T_ref_est.y(), 6);
+  json["align_theta_deg"] = json_fixed(kDegPerRad * ev.alignment.T_ref_est.theta(), 6);
 }
 
-void add_closures(const ClosureEvaluation& ev, JsonLine& json) {
-  json.add_int("loop_closures", static_cast<long long>(ev.closures))
-      .add_int("false_loop_closures", static_cast<long long>(ev.false_closures))
-      .add_int("loop_closures_unmatched", static_cast<long long>(ev.unmatched))
-      .add_int("loop_closures_bad_covariance", static_cast<long long>(ev.bad_covariance))
-      .add("loop_closure_max_mahalanobis", ev.max_mahalanobis, 3)
-      .add("loop_closure_max_error_m", ev.max_error_m)
-      .add("loop_closure_rms_error_m", ev.rms_error_m);
+void add_closures(const ClosureEvaluation& ev, Json& json) {
+  json["loop_closures"] = ev.closures;
+  json["false_loop_closures"] = ev.false_closures;
+  json["loop_closures_unmatched"] = ev.unmatched;
+  json["loop_closures_bad_covariance"] = ev.bad_covariance;
+  json["loop_closure_max_mahalanobis"] = json_fixed(ev.max_mahalanobis, 3);
+  json["loop_closure_max_error_m"] = json_fixed(ev.max_error_m, 6);
+  json["loop_closure_rms_error_m"] = json_fixed(ev.rms_error_m, 6);
 }
 
-void add_relations(const RelationsEvaluation& ev, JsonLine& json) {
+void add_relations(const RelationsEvaluation& ev, Json& json) {
   const bool report = !ev.refused && ev.used > 0;
-  const auto figure = [&](double value) {
-    return report ? std::optional<double>(value) : std::nullopt;
+  const auto figure = [&](double value, int decimals = 6) {
+    return report ? json_fixed(value, decimals) : Json();
   };
-  json.add_int("relations", static_cast<long long>(ev.relations))
-      .add_int("relations_used", static_cast<long long>(ev.used))
-      .add_int("relations_missing", static_cast<long long>(ev.missing))
-      .add("relations_share", ev.share, 4)
-      .add_bool("refused", ev.refused)
-      .add("trans_mean_m", figure(ev.translation_m.mean))
-      .add("trans_sd_m", figure(ev.translation_m.sd))
-      .add("trans_max_m", figure(ev.translation_m.max))
-      .add("trans_sq_mean_m2", figure(ev.translation_sq_m2.mean), 8)
-      .add("trans_sq_sd_m2", figure(ev.translation_sq_m2.sd), 8)
-      .add("rot_mean_deg", figure(ev.rotation_deg.mean))
-      .add("rot_sd_deg", figure(ev.rotation_deg.sd))
-      .add("rot_max_deg", figure(ev.rotation_deg.max))
-      .add("rot_sq_mean_deg2", figure(ev.rotation_sq_deg2.mean))
-      .add("rot_sq_sd_deg2", figure(ev.rotation_sq_deg2.sd));
+  json["relations"] = ev.relations;
+  json["relations_used"] = ev.used;
+  json["relations_missing"] = ev.missing;
+  json["relations_share"] = json_fixed(ev.share, 4);
+  json["refused"] = ev.refused;
+  json["trans_mean_m"] = figure(ev.translation_m.mean);
+  json["trans_sd_m"] = figure(ev.translation_m.sd);
+  json["trans_max_m"] = figure(ev.translation_m.max);
+  json["trans_sq_mean_m2"] = figure(ev.translation_sq_m2.mean, 8);
+  json["trans_sq_sd_m2"] = figure(ev.translation_sq_m2.sd, 8);
+  json["rot_mean_deg"] = figure(ev.rotation_deg.mean);
+  json["rot_sd_deg"] = figure(ev.rotation_deg.sd);
+  json["rot_max_deg"] = figure(ev.rotation_deg.max);
+  json["rot_sq_mean_deg2"] = figure(ev.rotation_sq_deg2.mean);
+  json["rot_sq_sd_deg2"] = figure(ev.rotation_sq_deg2.sd);
 }
 
 bool write_relations_csv(const RelationsEvaluation& ev, const std::string& path) {

@@ -4,10 +4,9 @@
 
 #include <optional>
 #include <string>
-#include <utility>
-#include <vector>
 
 #include "evaluator.hpp"
+#include "json.hpp"
 
 namespace traverse::evaluator {
 
@@ -23,31 +22,19 @@ bool write_closures_csv(const ClosureEvaluation& ev, const std::string& path);
 std::optional<std::string> plot_errors(const std::string& script, const std::string& csv,
                                        const std::string& png, const std::string& title);
 
-// A flat JSON object on one line, built key by key; numbers carry their unit in the key.
-class JsonLine {
- public:
-  JsonLine& add(const std::string& key, const std::string& value);        // a string
-  JsonLine& add(const std::string& key, double value, int decimals = 6);  // null if not finite
-  JsonLine& add(const std::string& key, std::optional<double> value, int decimals = 6);
-  JsonLine& add_int(const std::string& key, long long value);
-  JsonLine& add_bool(const std::string& key, bool value);
-  JsonLine& add_null(const std::string& key);
-  std::string str() const;
-
- private:
-  std::vector<std::pair<std::string, std::string>> fields_;  // key, encoded value
-};
+// The summary is one flat JSON object on one line; numbers carry their unit in the key and are
+// written with a fixed number of decimals (6 unless said), null when unknown.
 
 // The figures of an evaluation under the keys scripts and later stages rely on.
-void add_evaluation(const Evaluation& ev, JsonLine& json);
+void add_evaluation(const Evaluation& ev, Json& json);
 
 // The loop-closure figures: always present, counts 0 and figures null when there is no closure.
-void add_closures(const ClosureEvaluation& ev, JsonLine& json);
+void add_closures(const ClosureEvaluation& ev, Json& json);
 
 // The relations figures (relations.hpp): counts always, figures null when refused. Keys:
 // relations, relations_used, relations_missing, relations_share, refused, trans_{mean,sd,max}_m,
 // trans_sq_{mean,sd}_m2, rot_{mean,sd,max}_deg, rot_sq_{mean,sd}_deg2.
-void add_relations(const RelationsEvaluation& ev, JsonLine& json);
+void add_relations(const RelationsEvaluation& ev, Json& json);
 
 // One row per relation: stamps, used, the relation and the estimate's relative pose, errors.
 bool write_relations_csv(const RelationsEvaluation& ev, const std::string& path);

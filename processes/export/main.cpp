@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <nlohmann/json.hpp>
 
 #include "export_cloud.hpp"
+#include "json.hpp"
 #include "products.hpp"
 #include "version.hpp"
 
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   std::error_code ec;
   fs::create_directories(out, ec);
   const fs::path dir(out);
-  nlohmann::json j;
+  traverse::Json j;
   j["frame"] = frame;
   j["log"] = log;
   j["log_damaged_records"] = run.damaged_records;
@@ -103,10 +103,10 @@ int main(int argc, char** argv) {
   }
   auto file_entry = [](const fs::path& p) {
     std::error_code e;
-    return nlohmann::json{{"path", fs::absolute(p).string()},
+    return traverse::Json{{"path", fs::absolute(p).string()},
                           {"bytes", static_cast<int64_t>(fs::file_size(p, e))}};
   };
-  nlohmann::json files = nlohmann::json::object();
+  traverse::Json files = traverse::Json::object();
   bool ok = ex::write_tum((dir / "trajectory.tum").string(), dense, frame) &&
             ex::write_trajectory_csv((dir / "trajectory.csv").string(), dense, frame);
   files["trajectory_tum"] = file_entry(dir / "trajectory.tum");
@@ -170,7 +170,8 @@ int main(int argc, char** argv) {
   }
   j["levels"] = {{"top", top}, {"bottom", bottom}};
   j["files"] = files;
-  std::ofstream(dir / "export.json") << j.dump(2) << "\n";
-  std::cout << j.dump() << std::endl;
+  std::ofstream(dir / "export.json")
+      << j.dump(2, ' ', true, traverse::Json::error_handler_t::replace) << "\n";
+  std::cout << traverse::json_line(j) << std::endl;
   return 0;
 }

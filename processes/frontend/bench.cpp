@@ -17,6 +17,7 @@
 #include "channels.hpp"
 #include "config.hpp"
 #include "frontend.hpp"
+#include "json.hpp"
 #include "lcm_log.hpp"
 #include "scan_message.hpp"
 #include "synthetic_scans.hpp"
@@ -205,13 +206,21 @@ int main(int argc, char** argv) {
     std::printf("position error: %.4f m (%s)\n", t.error_m,
                 log_path.empty() ? "final, synthetic" : "RMS against ground truth");
   }
-  std::printf(
-      "{\"input\": \"%s\", \"scans\": %zu, \"points_per_scan\": %d, \"matched_points_per_scan\": "
-      "%d, "
-      "\"per_scan_median_ms\": %.3f, \"per_scan_p99_ms\": %.3f, \"per_scan_mean_ms\": %.3f, "
-      "\"per_scan_max_ms\": %.3f, \"scanner_rate_hz\": %.2f, \"real_time_factor\": %.2f, "
-      "\"map_bytes\": %zu, \"map_updates\": %.0f, \"position_error_m\": %.5f}\n",
-      log_path.empty() ? "synthetic" : "log", t.ms.size(), t.points, t.matched_points, median, p99,
-      mean, sorted.back(), t.rate_hz, rtf, frontend->map_bytes(), c["map_updates"], t.error_m);
+  using traverse::json_fixed;
+  traverse::Json j;
+  j["input"] = log_path.empty() ? "synthetic" : "log";
+  j["scans"] = t.ms.size();
+  j["points_per_scan"] = t.points;
+  j["matched_points_per_scan"] = t.matched_points;
+  j["per_scan_median_ms"] = json_fixed(median, 3);
+  j["per_scan_p99_ms"] = json_fixed(p99, 3);
+  j["per_scan_mean_ms"] = json_fixed(mean, 3);
+  j["per_scan_max_ms"] = json_fixed(sorted.back(), 3);
+  j["scanner_rate_hz"] = json_fixed(t.rate_hz, 2);
+  j["real_time_factor"] = json_fixed(rtf, 2);
+  j["map_bytes"] = frontend->map_bytes();
+  j["map_updates"] = json_fixed(c["map_updates"], 0);
+  j["position_error_m"] = json_fixed(t.error_m, 5);
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return 0;
 }

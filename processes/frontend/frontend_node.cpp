@@ -1,5 +1,7 @@
 #include "frontend_node.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -171,15 +173,41 @@ void FrontendNode::publish(const FrontendResult& result) {
   const auto period_us = static_cast<int64_t>(config_.handover.save_period_s * 1e6);
   if (!state_dir_.empty() && period_us > 0 &&
       (last_saved_utime_ == INT64_MIN || result.utime - last_saved_utime_ >= period_us)) {
-    save_state();
+    save_in_background();
     last_saved_utime_ = result.utime;
   }
 }
 
-void FrontendNode::save_state() {
+FrontendNode::~FrontendNode() {
+  if (writing_.valid()) writing_.wait();
+}
+
+void FrontendNode::save_in_background() {
+  if (handover_.empty() || !resume_failure_.empty()) return;
+  if (writing_.valid() && writing_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    ++saves_skipped_;
+    return;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string bytes = handover_.serialise();
+  state_bytes_ = static_cast<double>(bytes.size());
+  writing_ = std::async(std::launch::async,
+                        [path = state_dir_ + "/frontend.state", bytes = std::move(bytes)] {
+                          return write_snapshot(path, kStateMagic, bytes, false);
+                        });
+  const double took_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++saves_;
+  save_total_s_ += took_s;
+  save_max_s_ = std::max(save_max_s_, took_s);
+}
+
+void FrontendNode::save_state(bool durable) {
+  if (writing_.valid()) writing_.wait();  // the last periodic save is not renamed in after this
   if (state_dir_.empty() || handover_.empty() || !resume_failure_.empty()) return;
-  // A session ends here: the window is worth flushing to the disk.
-  write_snapshot(state_dir_ + "/frontend.state", kStateMagic, handover_.serialise(), true);
+  const std::string bytes = handover_.serialise();
+  state_bytes_ = static_cast<double>(bytes.size());
+  write_snapshot(state_dir_ + "/frontend.state", kStateMagic, bytes, durable);
 }
 
 void FrontendNode::report_counters() {
@@ -193,6 +221,13 @@ void FrontendNode::report_counters() {
   counters_("frontend_control_rejected", static_cast<double>(control_rejected_));
   counters_("handover_misfit_m", last_misfit_m_);
   counters_("handover_misfit_rad", last_misfit_rad_);
+  if (!state_dir_.empty()) {
+    counters_("state_saves", static_cast<double>(saves_));
+    counters_("state_saves_skipped", static_cast<double>(saves_skipped_));
+    counters_("state_save_total_s", save_total_s_);
+    counters_("state_save_max_s", save_max_s_);
+    counters_("state_bytes", state_bytes_);
+  }
   if (resumed_scans_) {
     counters_("resumed_scans", static_cast<double>(*resumed_scans_));
     counters_("resume_worst_fit", worst_fit_);

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <thread>
 
+#include "json.hpp"
+
 namespace fs = std::filesystem;
 
 namespace traverse::launch {
@@ -17,6 +19,16 @@ std::string read_file(const fs::path& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// True when processes.json (as the launcher writes it) lists a running process.
+bool any_running(const std::string& processes_json) {
+  const Json j = Json::parse(processes_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return false;
+  for (const auto& p : j.value("processes", Json::array())) {
+    if (p.is_object() && p.value("running", false)) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -66,7 +78,7 @@ int send_control(const fs::path& out_dir, const std::string& command, const std:
       std::fprintf(stderr, "run-graph: --control %s needs --process NAME\n", command.c_str());
       return 2;
     }
-    if (read_file(status).find("\"running\":true") == std::string::npos) {
+    if (!any_running(read_file(status))) {
       std::fprintf(stderr, "run-graph: no run in progress in %s (%s shows nothing running)\n",
                    out_dir.c_str(), status.c_str());
       return 1;

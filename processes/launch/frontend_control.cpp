@@ -7,6 +7,7 @@
 
 #include "bus.hpp"
 #include "channels.hpp"
+#include "json.hpp"
 #include "process.hpp"
 #include "traverse/frontend_control_t.hpp"
 #include "traverse/process_status_t.hpp"
@@ -72,8 +73,12 @@ int send_frontend_control(const std::filesystem::path& out_dir, const std::strin
     }
     return 1;
   }
-  std::printf("{\"process\":\"%s\",\"kind\":\"%s\",\"request_id\":%lld,\"swaps\":%.0f}\n",
-              process.c_str(), kind.c_str(), static_cast<long long>(id), seen["frontend_swaps"]);
+  Json j;
+  j["process"] = process;
+  j["kind"] = kind;
+  j["request_id"] = static_cast<long long>(id);
+  j["swaps"] = static_cast<long long>(seen["frontend_swaps"]);
+  std::printf("%s\n", json_line(j).c_str());
   return 0;
 }
 

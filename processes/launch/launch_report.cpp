@@ -3,17 +3,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "json_escape.hpp"
+#include "json.hpp"
 
 namespace traverse::launch {
 namespace {
-
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  out += json_escape(s);
-  out += '"';
-  return out;
-}
 
 std::string number(double v) {
   char buf[32];
@@ -57,15 +50,19 @@ int finish_report(RunReport& report, const Supervisor& sup, bool all_started) {
 }
 
 std::string processes_json(const Supervisor& sup) {
-  std::string j = "{\"processes\":[";
+  Json j;
+  j["processes"] = Json::array();
   for (const Child& c : sup.children()) {
-    if (j.back() != '[') j += ',';
-    j += "{\"name\":" + quoted(c.name) + ",\"host\":" + quoted(c.host) +
-         ",\"pid\":" + std::to_string(c.pid) + ",\"running\":" + (c.running ? "true" : "false") +
-         ",\"restarts\":" + std::to_string(c.restarts) + ",\"outcome\":" + quoted(c.outcome()) +
-         "}";
+    Json p;
+    p["name"] = c.name;
+    p["host"] = c.host;
+    p["pid"] = c.pid;
+    p["running"] = c.running;
+    p["restarts"] = c.restarts;
+    p["outcome"] = c.outcome();
+    j["processes"].push_back(std::move(p));
   }
-  return j + "]}";
+  return json_line(j);
 }
 
 std::string to_text(const RunReport& report) {
@@ -95,42 +92,32 @@ std::string to_text(const RunReport& report) {
 }
 
 std::string to_json(const RunReport& report) {
-  std::string j =
-      "{\"ok\":" + std::string(report.ok ? "true" : "false") + ",\"url\":" + quoted(report.url) +
-      ",\"out\":" + quoted(report.out_dir) + ",\"replay_s\":" + number(report.replay_s) +
-      ",\"duration_s\":" + number(report.duration_s) +
-      ",\"interrupted\":" + (report.interrupted ? "true" : "false") + ",\"processes\":[";
-  for (std::size_t i = 0; i < report.children.size(); ++i) {
-    const auto& c = report.children[i];
-    if (i) j += ',';
-    j += "{\"name\":" + quoted(c.name) + ",\"host\":" + quoted(c.host) +
-         ",\"program\":" + quoted(c.program) + ",\"restarts\":" + std::to_string(c.restarts) +
-         ",\"outcome\":" + quoted(c.outcome) + ",\"exit_code\":" + std::to_string(c.exit_code) +
-         ",\"signal\":" + std::to_string(c.signal) +
-         ",\"failed\":" + (c.failed ? "true" : "false") + "}";
+  Json j;
+  j["ok"] = report.ok;
+  j["url"] = report.url;
+  j["out"] = report.out_dir;
+  j["replay_s"] = json_fixed(report.replay_s, 3);
+  j["duration_s"] = json_fixed(report.duration_s, 3);
+  j["interrupted"] = report.interrupted;
+  j["processes"] = Json::array();
+  for (const auto& c : report.children) {
+    Json p;
+    p["name"] = c.name;
+    p["host"] = c.host;
+    p["program"] = c.program;
+    p["restarts"] = c.restarts;
+    p["outcome"] = c.outcome;
+    p["exit_code"] = c.exit_code;
+    p["signal"] = c.signal;
+    p["failed"] = c.failed;
+    j["processes"].push_back(std::move(p));
   }
-  j += "],\"failed\":[";
-  for (std::size_t i = 0; i < report.failed.size(); ++i) {
-    if (i) j += ',';
-    j += quoted(report.failed[i]);
-  }
-  j += "],\"problems\":[";
-  for (std::size_t k = 0; k < report.verdict_problems.size(); ++k) {
-    if (k) j += ',';
-    j += quoted(report.verdict_problems[k]);
-  }
-  j += "],\"events\":[";
-  for (std::size_t k = 0; k < report.events.size(); ++k) {
-    if (k) j += ',';
-    j += quoted(report.events[k]);
-  }
-  j += "],\"stopped_by\":" + quoted(report.stopped_by) + ",\"not_ready\":[";
-  std::size_t i = 0;
-  for (const auto& n : report.not_ready) {
-    if (i++) j += ',';
-    j += quoted(n);
-  }
-  return j + "]}";
+  j["failed"] = report.failed;
+  j["problems"] = report.verdict_problems;
+  j["events"] = report.events;
+  j["stopped_by"] = report.stopped_by;
+  j["not_ready"] = report.not_ready;
+  return json_line(j);
 }
 
 }  // namespace traverse::launch

@@ -131,10 +131,13 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
   if (plan.records) {
     std::vector<std::string> monitor_argv = plan.monitor_argv;
     monitor_argv.insert(monitor_argv.begin() + 1, {"--lcm-url", o.lcm_url});
-    // LCM_SELF_TEST is udpm's own start-up probe, not part of the run: not recorded.
+    // LCM_SELF_TEST is udpm's own start-up probe, not part of the run: not recorded; nor are
+    // the channels of --record-without (lcm-logger matches the whole name: ^(...)$).
+    const std::string skipped =
+        "(LCM_SELF_TEST" + (o.record_without.empty() ? "" : "|" + o.record_without) + ")";
     spawned =
         sup.spawn("logger",
-                  {plan.logger, "-f", "-q", "-v", "--channel=LCM_SELF_TEST", url_arg,
+                  {plan.logger, "-f", "-q", "-v", "--channel=" + skipped, url_arg,
                    (out_dir / "run.lcmlog").string()},
                   (out_dir / "logger.log").string(), error, plan.host) &&
         sup.spawn("monitor", monitor_argv, (out_dir / "monitor.log").string(), error, plan.host);

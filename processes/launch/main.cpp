@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <regex>
 
 #include "config.hpp"
 #include "control.hpp"
@@ -72,6 +73,9 @@ void add_options(CLI::App& app, Options& o) {
   app.add_flag("--offline", o.offline,
                "no bus: run the stages one after another on the log (--replay/--record), as "
                "fast as they compute and without transport loss; --speed is ignored");
+  app.add_option("--record-without", o.record_without,
+                 "channels left out of run.lcmlog: a regex over the whole channel name, e.g. "
+                 "'SCAN_.*|IMU' (the processes and the monitor still hear them)");
   app.add_flag("--raise-rmem-max", o.raise_rmem_max,
                "as root, raise net.core.rmem_max (system-wide) to the URL's recv_buf_size");
 }
@@ -115,6 +119,13 @@ int main(int argc, char** argv) {
   }
   if (o.deploy.empty()) {
     std::fprintf(stderr, "run-graph: --deploy is required\n");
+    return traverse::kConfigErrorExitCode;
+  }
+  try {
+    std::regex check(o.record_without);
+  } catch (const std::regex_error& e) {
+    std::fprintf(stderr, "run-graph: --record-without '%s' is not a regular expression: %s\n",
+                 o.record_without.c_str(), e.what());
     return traverse::kConfigErrorExitCode;
   }
   traverse::launch::Deployment deployment;

@@ -2,9 +2,12 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <regex>
 #include <thread>
 
 #include "launch_report.hpp"
+#include "lcm_log.hpp"
 #include "process.hpp"
 #include "run_checks.hpp"
 #include "run_modes.hpp"
@@ -12,6 +15,29 @@
 namespace fs = std::filesystem;
 
 namespace traverse::launch {
+namespace {
+
+// The intact events of `in` whose channel does not match `skip` (the whole name), renumbered.
+bool copy_log_without(const fs::path& in, const fs::path& out, const std::string& skip) {
+  const std::regex skipped(skip);
+  lcm::LogFile log(out.string(), "w");
+  if (!log.good()) return false;
+  LogReader reader(in.string());
+  int64_t number = 0;
+  while (auto ev = reader.next()) {
+    if (std::regex_match(ev->channel, skipped)) continue;
+    lcm::LogEvent e;
+    e.eventnum = number++;
+    e.timestamp = ev->utime;
+    e.channel = ev->channel;
+    e.datalen = static_cast<int32_t>(ev->data.size());
+    e.data = ev->data.data();
+    if (log.writeEvent(&e) != 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
 
 // --offline: each stage reads the previous stage's record (the first reads the input log) with
 // --replay and writes its own with --record: everything the input had plus what the stage
@@ -52,7 +78,13 @@ int run_offline(const Options& o, const Plan& plan, const fs::path& out_dir) {
   }
   sup.stop(names, o.stop_timeout_s);
   std::error_code ec;
-  if (ok && !stop_requested() && input != fs::absolute(o.log)) {
+  if (ok && !stop_requested() && !o.record_without.empty()) {
+    // The stages hand each other whole records; run.lcmlog keeps what --record-without leaves.
+    if (!copy_log_without(input, out_dir / "run.lcmlog", o.record_without)) {
+      ec = std::make_error_code(std::errc::io_error);
+    }
+    if (input != fs::absolute(o.log)) fs::remove(input);
+  } else if (ok && !stop_requested() && input != fs::absolute(o.log)) {
     fs::rename(input, out_dir / "run.lcmlog", ec);
   } else if (ok && !stop_requested()) {
     fs::copy_file(input, out_dir / "run.lcmlog", fs::copy_options::overwrite_existing, ec);

@@ -3,8 +3,8 @@
 #include <unistd.h>
 
 #include <fstream>
-#include <sstream>
 
+#include "json.hpp"
 #include "lcm_log.hpp"
 
 namespace traverse::launch {
@@ -28,26 +28,15 @@ std::vector<std::string> input_log_problems(const std::string& path) {
 
 std::vector<std::string> monitor_problems(const std::string& monitor_json) {
   std::ifstream in(monitor_json);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string json = text.str();
   if (!in) return {"no monitor summary " + monitor_json + ": the run has no verdict"};
-  if (json.find("\"ok\":true}") != std::string::npos) return {};
+  const Json j = Json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("ok")) {
+    return {"monitor: " + monitor_json + " is not the monitor's summary: the run has no verdict"};
+  }
+  if (j["ok"] == true) return {};
   std::vector<std::string> out;
-  // The problems array: strings as the JSON writer escapes them (no '"' left unescaped).
-  const std::string key = "\"problems\":[";
-  auto at = json.find(key);
-  if (at != std::string::npos) {
-    at += key.size();
-    while (at < json.size() && json[at] == '"') {
-      std::string problem;
-      for (++at; at < json.size() && json[at] != '"'; ++at) {
-        if (json[at] == '\\' && at + 1 < json.size()) ++at;
-        problem += json[at];
-      }
-      out.push_back("monitor: " + problem);
-      at += json.compare(at, 2, "\",") == 0 ? 2 : 1;
-    }
+  for (const auto& p : j.value("problems", Json::array())) {
+    if (p.is_string()) out.push_back("monitor: " + p.get<std::string>());
   }
   if (out.empty()) out.push_back("monitor: the run is not ok (see " + monitor_json + ")");
   return out;

@@ -15,6 +15,7 @@ namespace traverse::launch {
 struct Options {
   std::string deploy, log, out, stages = "all", lcm_url, root = ".", bin_dir, host;
   std::string control, process;  // --control COMMAND [--process NAME]: a running launcher
+  std::string record_without;    // channels (a regex over the whole name) run.lcmlog leaves out
   std::string kind;              // --control frontend --kind KIND
   std::string resume;            // --resume EARLIER_OUT: the session's saved state
   double speed = 1.0, grace_s = 2.0, stop_timeout_s = 5.0, ready_timeout_s = 10.0;

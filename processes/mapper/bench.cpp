@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "config.hpp"
+#include "json.hpp"
 #include "mapper.hpp"
 #include "simulator.hpp"
 #include "version.hpp"
@@ -177,19 +178,31 @@ int main(int argc, char** argv) {
   const double bytes_per_s = runs[0].profile_bytes / span_s;
   std::printf("stored profiles: %.2f MB per s of data -> %.2f GB for a 30-minute session\n",
               bytes_per_s / 1e6, bytes_per_s * 1800 / 1e9);
-  std::printf(
-      "{\"bench\": \"mapper\", \"route\": \"%s\", \"profiles\": %zu, \"data_s\": %.2f, "
-      "\"beams\": %lld, \"points_per_s_2cm\": %.0f, \"points_per_s_5cm\": %.0f, "
-      "\"beams_per_s_2cm\": %.0f, \"beams_per_s_5cm\": %.0f, \"octomap_points_per_s_2cm\": %.0f, "
-      "\"octomap_points_per_s_5cm\": %.0f, \"ratio_to_octomap_2cm\": %.2f, "
-      "\"ratio_to_octomap_5cm\": %.2f, \"octomap_baseline_s\": %.1f, \"move_s_2cm\": %.3f, "
-      "\"small_move_s_2cm\": %.3f, \"small_move_s_2cm_2threads\": %.3f, \"moved_profiles\": %lld, \"moved_profiles_per_s_2cm\": %.0f, "
-      "\"small_moved_profiles_per_s_2cm\": %.0f, \"profile_bytes_per_s\": %.0f, \"keeps_up_244k\": %s}\n",
-      route_file.c_str(), profiles.size(), span_s, static_cast<long long>(beams), pps[0], pps[1],
-      beams / runs[0].mapper_s, beams / runs[1].mapper_s, octo[0], octo[1], ratio[0], ratio[1],
-      baseline_s, runs[0].move_s, runs[0].small_move_s, runs[0].small_move_2threads_s,
-      static_cast<long long>(runs[0].moved_profiles), runs[0].moved_profiles / runs[0].move_s,
-      runs[0].small_moved_profiles / runs[0].small_move_s, bytes_per_s,
-      beams / runs[0].mapper_s >= 244000 && beams / runs[1].mapper_s >= 244000 ? "true" : "false");
+  using traverse::json_fixed;
+  traverse::Json j;
+  j["bench"] = "mapper";
+  j["route"] = route_file;
+  j["profiles"] = profiles.size();
+  j["data_s"] = json_fixed(span_s, 2);
+  j["beams"] = static_cast<long long>(beams);
+  j["points_per_s_2cm"] = json_fixed(pps[0], 0);
+  j["points_per_s_5cm"] = json_fixed(pps[1], 0);
+  j["beams_per_s_2cm"] = json_fixed(beams / runs[0].mapper_s, 0);
+  j["beams_per_s_5cm"] = json_fixed(beams / runs[1].mapper_s, 0);
+  j["octomap_points_per_s_2cm"] = json_fixed(octo[0], 0);
+  j["octomap_points_per_s_5cm"] = json_fixed(octo[1], 0);
+  j["ratio_to_octomap_2cm"] = json_fixed(ratio[0], 2);
+  j["ratio_to_octomap_5cm"] = json_fixed(ratio[1], 2);
+  j["octomap_baseline_s"] = json_fixed(baseline_s, 1);
+  j["move_s_2cm"] = json_fixed(runs[0].move_s, 3);
+  j["small_move_s_2cm"] = json_fixed(runs[0].small_move_s, 3);
+  j["small_move_s_2cm_2threads"] = json_fixed(runs[0].small_move_2threads_s, 3);
+  j["moved_profiles"] = static_cast<long long>(runs[0].moved_profiles);
+  j["moved_profiles_per_s_2cm"] = json_fixed(runs[0].moved_profiles / runs[0].move_s, 0);
+  j["small_moved_profiles_per_s_2cm"] =
+      json_fixed(runs[0].small_moved_profiles / runs[0].small_move_s, 0);
+  j["profile_bytes_per_s"] = json_fixed(bytes_per_s, 0);
+  j["keeps_up_244k"] = beams / runs[0].mapper_s >= 244000 && beams / runs[1].mapper_s >= 244000;
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return 0;
 }

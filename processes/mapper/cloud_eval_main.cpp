@@ -6,10 +6,10 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <map>
-#include <sstream>
 
 #include "cloud_eval.hpp"
 #include "config.hpp"
+#include "json.hpp"
 #include "lcm_log.hpp"
 #include "ply.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -125,12 +125,12 @@ int main(int argc, char** argv) {
   std::printf("point to surface: mode %.2f mm, mean %.2f mm, RMSE %.2f mm, p95 %.2f mm\n",
               1e3 * r.surface.mode, 1e3 * r.surface.mean, 1e3 * r.surface.rmse,
               1e3 * r.surface.p95);
-  std::ostringstream pillars, corridors;
+  const auto fixed6 = [](std::optional<double> v) { return traverse::json_fixed(v, 6); };
+  traverse::Json pillars = traverse::Json::array(), corridors = traverse::Json::array();
   for (const auto& p : r.pillars) {
     std::printf("pillar %s: %d points, centre error %s\n", p.id.c_str(), p.points,
                 p.error_m ? (num(1e3 * *p.error_m) + " mm").c_str() : "not fitted");
-    pillars << (pillars.tellp() > 0 ? ", " : "") << "{\"id\": \"" << p.id
-            << "\", \"points\": " << p.points << ", \"error_m\": " << opt(p.error_m) << "}";
+    pillars.push_back({{"id", p.id}, {"points", p.points}, {"error_m", fixed6(p.error_m)}});
   }
   std::printf("pillars: n %d, mean %.2f mm, SD %.2f mm, RMSE %.2f mm, min %.2f mm, max %.2f mm\n",
               r.pillar.n, 1e3 * r.pillar.mean, 1e3 * r.pillar.sd, 1e3 * r.pillar.rmse,
@@ -138,26 +138,34 @@ int main(int argc, char** argv) {
   for (const auto& c : r.corridors) {
     std::printf("corridor %s: %s m in the cloud, %.3f m true (%d and %d points at its ends)\n",
                 c.name.c_str(), opt(c.length_m).c_str(), c.true_length_m, c.points_a, c.points_b);
-    corridors << (corridors.tellp() > 0 ? ", " : "") << "{\"name\": \"" << c.name
-              << "\", \"length_m\": " << opt(c.length_m)
-              << ", \"true_length_m\": " << num(c.true_length_m) << ", \"points_a\": " << c.points_a
-              << ", \"points_b\": " << c.points_b
-              << ", \"error_m\": " << (c.length_m ? num(*c.length_m - c.true_length_m) : "null")
-              << "}";
+    corridors.push_back(
+        {{"name", c.name},
+         {"length_m", fixed6(c.length_m)},
+         {"true_length_m", fixed6(c.true_length_m)},
+         {"points_a", c.points_a},
+         {"points_b", c.points_b},
+         {"error_m", c.length_m ? fixed6(*c.length_m - c.true_length_m) : traverse::Json()}});
   }
   const bool fitted = r.pillar.n > 0;
-  std::printf(
-      "{\"cloud_points\": %zu, \"cloud_points_evaluated\": %d, \"cloud_mode_m\": %s, "
-      "\"cloud_mean_m\": %s, \"cloud_rmse_m\": %s, \"cloud_p95_m\": %s, \"pillar_n\": %d, "
-      "\"pillar_mean_m\": %s, \"pillar_sd_m\": %s, \"pillar_rmse_m\": %s, \"pillar_min_m\": %s, "
-      "\"pillar_max_m\": %s, \"cloud_align_x_m\": %.6f, \"cloud_align_y_m\": %.6f, "
-      "\"cloud_align_theta_rad\": %.6f, "
-      "\"pillars\": [%s], \"corridors\": [%s]}\n",
-      cloud->size(), r.surface.n, num(r.surface.mode).c_str(), num(r.surface.mean).c_str(),
-      num(r.surface.rmse).c_str(), num(r.surface.p95).c_str(), r.pillar.n,
-      fitted ? num(r.pillar.mean).c_str() : "null", fitted ? num(r.pillar.sd).c_str() : "null",
-      fitted ? num(r.pillar.rmse).c_str() : "null", fitted ? num(r.pillar.min).c_str() : "null",
-      fitted ? num(r.pillar.max).c_str() : "null", T_world_map.x(), T_world_map.y(),
-      T_world_map.theta(), pillars.str().c_str(), corridors.str().c_str());
+  const auto pillar = [&](double v) { return fitted ? fixed6(v) : traverse::Json(); };
+  traverse::Json j;
+  j["cloud_points"] = cloud->size();
+  j["cloud_points_evaluated"] = r.surface.n;
+  j["cloud_mode_m"] = fixed6(r.surface.mode);
+  j["cloud_mean_m"] = fixed6(r.surface.mean);
+  j["cloud_rmse_m"] = fixed6(r.surface.rmse);
+  j["cloud_p95_m"] = fixed6(r.surface.p95);
+  j["pillar_n"] = r.pillar.n;
+  j["pillar_mean_m"] = pillar(r.pillar.mean);
+  j["pillar_sd_m"] = pillar(r.pillar.sd);
+  j["pillar_rmse_m"] = pillar(r.pillar.rmse);
+  j["pillar_min_m"] = pillar(r.pillar.min);
+  j["pillar_max_m"] = pillar(r.pillar.max);
+  j["cloud_align_x_m"] = fixed6(T_world_map.x());
+  j["cloud_align_y_m"] = fixed6(T_world_map.y());
+  j["cloud_align_theta_rad"] = fixed6(T_world_map.theta());
+  j["pillars"] = std::move(pillars);
+  j["corridors"] = std::move(corridors);
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return 0;
 }

@@ -10,8 +10,14 @@
 namespace traverse::mapper {
 
 MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
-                       CounterSink counters, bool worker_thread)
+                       CounterSink counters, bool worker_thread, const std::string& state_dir)
     : bus_(bus), config_(config), mapper_(config, T_base_laser), counters_(std::move(counters)) {
+  if (!state_dir.empty()) {
+    state_ = std::make_unique<MapperStateStore>(state_dir, config_.range_max_m);
+    if (auto saved = state_->load()) resume(*saved);
+  }
+  // After the resume: the preview is of what is new (a viewer keeps what it was sent before; sent
+  // again, the old profiles would go back in time).
   if (!config_.preview.channel.empty()) {
     preview_ = std::make_unique<CloudPreview>(config_.preview);
     mapper_.on_first_placement(
@@ -44,6 +50,27 @@ void MapperNode::stop_worker() {
   if (worker_.joinable()) worker_.join();
 }
 
+void MapperNode::resume(SavedInputs& saved) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // The segments first (the newest revision of each, as on_segments keeps), then the profiles:
+  // each is placed once, with the poses it has now, which is the map the moves had made.
+  for (SavedSegment& s : saved.segments) {
+    auto known = revisions_.find(s.segment.key_id_first);
+    if (known != revisions_.end() && s.revision <= known->second) continue;
+    revisions_[s.segment.key_id_first] = s.revision;
+    next_key_id_ = std::max(next_key_id_, s.segment.key_id_first + 1);
+    Work w = std::move(s.segment);
+    apply(w);
+  }
+  for (Profile& p : saved.profiles) {
+    Work w = std::move(p);
+    apply(w);
+  }
+  settle();
+  resumed_ = Resumed{saved.profiles.size(), saved.segments.size(),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+}
+
 void MapperNode::on_profile(const planar_scan_t& msg) {
   Profile p{to_planar_scan(msg), {}};
   if (msg.n_intensities8 == msg.n_ranges) {
@@ -53,6 +80,7 @@ void MapperNode::on_profile(const planar_scan_t& msg) {
       p.intensities.push_back(static_cast<uint8_t>(static_cast<uint16_t>(v) >> 8));
     }
   }
+  if (state_) state_->record(p);
   submit(std::move(p));
   message_done();
 }
@@ -70,6 +98,7 @@ void MapperNode::on_segments(const dense_segments_t& msg) {
     s.utimes = seg.pose_utime;
     for (int i = 0; i < seg.n_poses; ++i)
       s.T_world_base.emplace_back(seg.x[i], seg.y[i], seg.theta[i]);
+    if (state_) state_->record(s, seg.revision);
     submit(std::move(s));
   }
   message_done();
@@ -88,6 +117,7 @@ void MapperNode::cut_segment() {
   TrajectorySegment next;
   next.utimes.push_back(open_.utimes.back());  // segments share their end pose
   next.T_world_base.push_back(open_.T_world_base.back());
+  if (state_) state_->record(open_, 0);
   submit(std::move(open_));
   open_ = std::move(next);
 }
@@ -260,6 +290,17 @@ void MapperNode::report_counters() {
   counters_("work_queued_max", max_queued);
   counters_("map_lag_s", lag);
   counters_("map_lag_max_s", lag_max);
+  if (state_) {
+    const MapperStateCounters& c = state_->counters();
+    counters_("state_bytes_appended", c.bytes_appended);
+    counters_("state_write_total_s", c.write_total_s);
+    counters_("state_compactions", static_cast<double>(c.compactions));
+    counters_("state_write_failures", static_cast<double>(c.write_failures));
+  }
+  if (resumed_) {
+    counters_("resumed_profiles", static_cast<double>(resumed_->profiles));
+    counters_("resumed_s", resumed_->seconds);
+  }
   if (preview_) {
     counters_("preview_points", static_cast<double>(preview_->points()));
     counters_("preview_messages", preview_messages_);

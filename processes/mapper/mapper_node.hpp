@@ -20,6 +20,10 @@
 // once; offline (--replay) the node works inline instead, which keeps memory bounded. The status
 // counters map_lag_s / map_lag_max_s say how long the map trails what has arrived [s]: the time
 // from the arrival of the oldest item of a batch until the batch, moves included, is in the map.
+//
+// With a state directory every profile and segment taken is also appended to it as it comes
+// (mapper_state.hpp), and a node made on a directory that holds some starts from them: the map of
+// before, rebuilt, then what comes next.
 #pragma once
 
 #include <chrono>
@@ -29,6 +33,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <variant>
@@ -36,6 +41,7 @@
 
 #include "bus.hpp"
 #include "mapper.hpp"
+#include "mapper_state.hpp"
 #include "traverse/annotations_t.hpp"
 #include "traverse/cloud_preview_t.hpp"
 #include "traverse/dense_segments_t.hpp"
@@ -48,8 +54,11 @@ class MapperNode {
  public:
   using CounterSink = std::function<void(const std::string& name, double value)>;
   // `worker_thread`: run the Mapper on its own thread (live); false: inline in the handlers.
+  // `state_dir`: keep the inputs there and start from those it holds; throws std::runtime_error
+  // naming the file when they are damaged.
   MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isometry3d& T_base_laser,
-             CounterSink counters = {}, bool worker_thread = true);
+             CounterSink counters = {}, bool worker_thread = true,
+             const std::string& state_dir = "");
   ~MapperNode();
   MapperNode(const MapperNode&) = delete;
   MapperNode& operator=(const MapperNode&) = delete;
@@ -69,6 +78,13 @@ class MapperNode {
   // The map; read it only after flush() or finish() and before the next message is handled.
   const Mapper& mapper() const { return mapper_; }
 
+  // What the node started from when its state directory held some.
+  struct Resumed {
+    std::size_t profiles = 0, segments = 0;
+    double seconds = 0.0;  // [s] wall time to read and place them
+  };
+  const std::optional<Resumed>& resumed() const { return resumed_; }
+
  private:
   using Work = std::variant<Profile, TrajectorySegment>;
   // Counters the worker publishes for the main thread.
@@ -83,6 +99,7 @@ class MapperNode {
   void on_annotations(const annotations_t& msg);
   void cut_segment();
 
+  void resume(SavedInputs& saved);
   void submit(Work work);
   void message_done();     // after each message's submits
   void apply(Work& work);  // worker side
@@ -103,6 +120,8 @@ class MapperNode {
   PointColours colours_;    // the annotations, by key pose (this thread only)
   double level_changes_ = 0;
   int64_t next_key_id_ = 0;
+  std::unique_ptr<MapperStateStore> state_;  // written on this thread
+  std::optional<Resumed> resumed_;
   // Worker side.
   int64_t latest_utime_ = 0;  // [us] newest profile time applied
   double rejected_ = 0, dropped_ = 0, segments_applied_ = 0, segments_rejected_ = 0;

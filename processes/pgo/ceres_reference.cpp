@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "graph_io.hpp"
+#include "json.hpp"
 #include "version.hpp"
 
 namespace {
@@ -137,15 +138,21 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::printf(
-      "{\"file\": \"%s\", \"vertices\": %zu, \"edges\": %zu, \"initial_chi2\": %.12g, "
-      "\"final_chi2\": %.12g, \"iterations\": %d, \"accepted_steps\": %d, \"converged\": %s, "
-      "\"termination\": \"%s\", \"solve_s\": %.6f, \"solve_cpu_s\": %.6f, "
-      "\"linear_solver\": \"%s\", \"threads\": %d}\n",
-      file.c_str(), graph.poses.size(), graph.edges.size(), initial_chi2, final_chi2, iterations,
-      summary.num_successful_steps, converged ? "true" : "false",
-      ceres::TerminationTypeToString(summary.termination_type), solve_s, solve_cpu_s,
-      ceres::SparseLinearAlgebraLibraryTypeToString(summary.sparse_linear_algebra_library_type),
-      threads);
+  traverse::Json j;
+  j["file"] = file;
+  j["vertices"] = graph.poses.size();
+  j["edges"] = graph.edges.size();
+  j["initial_chi2"] = traverse::json_significant(initial_chi2, 12);
+  j["final_chi2"] = traverse::json_significant(final_chi2, 12);
+  j["iterations"] = iterations;
+  j["accepted_steps"] = summary.num_successful_steps;
+  j["converged"] = converged;
+  j["termination"] = ceres::TerminationTypeToString(summary.termination_type);
+  j["solve_s"] = traverse::json_fixed(solve_s, 6);
+  j["solve_cpu_s"] = traverse::json_fixed(solve_cpu_s, 6);
+  j["linear_solver"] =
+      ceres::SparseLinearAlgebraLibraryTypeToString(summary.sparse_linear_algebra_library_type);
+  j["threads"] = threads;
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return converged ? 0 : 3;
 }

@@ -10,6 +10,7 @@
 
 #include "config.hpp"
 #include "graph_io.hpp"
+#include "json.hpp"
 #include "spa.hpp"
 #include "version.hpp"
 
@@ -123,17 +124,25 @@ int main(int argc, char** argv) {
     std::cerr << "traverse-pgo: cannot write " << out_path << '\n';
     return 1;
   }
-  std::printf(
-      "{\"file\": \"%s\", \"vertices\": %zu, \"edges\": %zu, \"components\": %d, "
-      "\"initialised_from_edges\": %s, \"initial_chi2\": %.12g, "
-      "\"final_chi2\": %.12g, \"iterations\": %d, \"accepted_steps\": %d, \"converged\": %s, "
-      "\"termination\": \"%s\", \"rejected_non_finite\": %d, \"solve_s\": %.6f, \"solve_cpu_s\": "
-      "%.6f, \"marginals\": %zu, "
-      "\"marginals_s\": %.6f, \"symbolic_analyses\": %d, \"factor_nnz\": %ld}\n",
-      file.c_str(), graph.poses.size(), graph.edges.size(), components,
-      read.initialised_from_edges ? "true" : "false", result.initial_chi2, result.final_chi2,
-      result.iterations, result.accepted_steps, result.converged ? "true" : "false",
-      result.termination.c_str(), result.rejected_non_finite, solve_s, solve_cpu_s,
-      marginals_recovered, marginals_s, optimizer.system().analyses(), optimizer.system().nnz_l());
+  traverse::Json j;
+  j["file"] = file;
+  j["vertices"] = graph.poses.size();
+  j["edges"] = graph.edges.size();
+  j["components"] = components;
+  j["initialised_from_edges"] = read.initialised_from_edges;
+  j["initial_chi2"] = traverse::json_significant(result.initial_chi2, 12);
+  j["final_chi2"] = traverse::json_significant(result.final_chi2, 12);
+  j["iterations"] = result.iterations;
+  j["accepted_steps"] = result.accepted_steps;
+  j["converged"] = result.converged;
+  j["termination"] = result.termination;
+  j["rejected_non_finite"] = result.rejected_non_finite;
+  j["solve_s"] = traverse::json_fixed(solve_s, 6);
+  j["solve_cpu_s"] = traverse::json_fixed(solve_cpu_s, 6);
+  j["marginals"] = marginals_recovered;
+  j["marginals_s"] = traverse::json_fixed(marginals_s, 6);
+  j["symbolic_analyses"] = optimizer.system().analyses();
+  j["factor_nnz"] = optimizer.system().nnz_l();
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return result.converged ? 0 : 3;
 }

@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "json.hpp"
 #include "process.hpp"
 #include "sim_node.hpp"
 
@@ -158,14 +159,14 @@ int main(int argc, char** argv) {
                "long, %.1f s\n",
                sim_s, wall_s, sim_s / std::max(wall_s, 1e-9), simulator->trajectory().length_m(),
                simulator->trajectory().duration_s());
-  std::string json = "{";
-  for (const auto& [k, v] : counts) json += "\"" + k + "\":" + std::to_string(v) + ",";
-  json += fmt::format("\"profile\":\"{}\",", profile);
-  json += fmt::format(
-      "\"sim_duration_s\":{:.3f},\"wall_s\":{:.3f},\"real_time_factor\":{:.3f},"
-      "\"route_length_m\":{:.2f},\"route_duration_s\":{:.2f}}}",
-      sim_s, wall_s, sim_s / std::max(wall_s, 1e-9), simulator->trajectory().length_m(),
-      simulator->trajectory().duration_s());
-  std::printf("%s\n", json.c_str());
+  traverse::Json json;
+  for (const auto& [k, v] : counts) json[k] = v;
+  json["profile"] = profile;
+  json["sim_duration_s"] = traverse::json_fixed(sim_s, 3);
+  json["wall_s"] = traverse::json_fixed(wall_s, 3);
+  json["real_time_factor"] = traverse::json_fixed(sim_s / std::max(wall_s, 1e-9), 3);
+  json["route_length_m"] = traverse::json_fixed(simulator->trajectory().length_m(), 2);
+  json["route_duration_s"] = traverse::json_fixed(simulator->trajectory().duration_s(), 2);
+  std::printf("%s\n", traverse::json_line(json).c_str());
   return rc;
 }

@@ -13,6 +13,7 @@
 
 #include "log_reader.hpp"
 #include "config.hpp"
+#include "json.hpp"
 #include "realism.hpp"
 #include "simulator.hpp"
 #include "version.hpp"
@@ -199,14 +200,20 @@ int main(int argc, char** argv) {
       "\nsigma_ratio %.3f (residual sigma), outlier_ratio %.3f (outliers per depth jump); "
       "simulated over real, mean over %d step(s); outliers of returns %.3f\n",
       sigma_ratio, outlier_ratio, used, share_sim / share_real);
-  std::printf(
-      "{\"sigma_ratio\": %.4f, \"outlier_ratio\": %.4f, \"sigma_real_m\": %.5f, "
-      "\"sigma_sim_m\": %.5f, \"outliers_per_jump_real\": %.4f, \"outliers_per_jump_sim\": %.4f, "
-      "\"outlier_fraction_real\": %.5f, \"outlier_fraction_sim\": %.5f, "
-      "\"outlier_fraction_ratio\": %.4f, \"steps\": %d, \"world\": \"%s\", \"route\": \"%s\", "
-      "\"seed\": %llu}\n",
-      sigma_ratio, outlier_ratio, sigma_real / used, sigma_sim / used, out_real / used,
-      out_sim / used, share_real / used, share_sim / used, share_sim / share_real, used,
-      world_path.c_str(), route_path.c_str(), static_cast<unsigned long long>(seed));
+  traverse::Json j;
+  j["sigma_ratio"] = traverse::json_fixed(sigma_ratio, 4);
+  j["outlier_ratio"] = traverse::json_fixed(outlier_ratio, 4);
+  j["sigma_real_m"] = traverse::json_fixed(sigma_real / used, 5);
+  j["sigma_sim_m"] = traverse::json_fixed(sigma_sim / used, 5);
+  j["outliers_per_jump_real"] = traverse::json_fixed(out_real / used, 4);
+  j["outliers_per_jump_sim"] = traverse::json_fixed(out_sim / used, 4);
+  j["outlier_fraction_real"] = traverse::json_fixed(share_real / used, 5);
+  j["outlier_fraction_sim"] = traverse::json_fixed(share_sim / used, 5);
+  j["outlier_fraction_ratio"] = traverse::json_fixed(share_sim / share_real, 4);
+  j["steps"] = used;
+  j["world"] = world_path;
+  j["route"] = route_path;
+  j["seed"] = seed;
+  std::printf("%s\n", traverse::json_line(j).c_str());
   return 0;
 }

@@ -24,25 +24,19 @@ LogValidation validate_log(const std::string& path) {
 }
 
 std::string to_json(const LogValidation& v) {
-  JsonWriter json;
-  json.begin_object();
-  json.field("log", v.log);
-  json.field("bytes", v.bytes);
-  json.field("events", v.events);
-  write_channels(json, v.channels);
-  json.key("damage").begin_array();
+  Json j;
+  j["log"] = v.log;
+  j["bytes"] = v.bytes;
+  j["events"] = v.events;
+  j["channels"] = channels_json(v.channels);
+  j["damage"] = Json::array();
   for (const LogDamage& d : v.damage) {
-    json.begin_object();
-    json.field("offset", d.offset);
-    json.field("what", d.what);
-    json.field("skipped_bytes", d.skipped_bytes);
-    json.end_object();
+    j["damage"].push_back(
+        {{"offset", d.offset}, {"what", d.what}, {"skipped_bytes", d.skipped_bytes}});
   }
-  json.end_array();
-  write_problems(json, v.problems);
-  json.field("ok", v.ok);
-  json.end_object();
-  return json.str();
+  j["problems"] = v.problems;
+  j["ok"] = v.ok;
+  return json_line(j);
 }
 
 std::string to_text(const LogValidation& v) {

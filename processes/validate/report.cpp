@@ -15,6 +15,9 @@ std::string number_or_dash(const std::optional<double>& v, const char* fmt) {
   return v ? format(fmt, *v) : "-";
 }
 
+// A figure as the summaries print it: nine significant digits, null when absent or not finite.
+Json figure(std::optional<double> v) { return json_significant(v, 9); }
+
 std::string short_type(const std::string& type) {
   const auto dot = type.rfind('.');
   return type.empty() ? "?" : type.substr(dot == std::string::npos ? 0 : dot + 1);
@@ -86,84 +89,75 @@ std::vector<std::string> process_problems(const ProcessSummaries& processes, con
   return out;
 }
 
-void write_channels(JsonWriter& json, const ChannelSummaries& channels) {
-  json.key("channels").begin_object();
+Json channels_json(const ChannelSummaries& channels) {
+  Json out = Json::object();
   for (const auto& [name, c] : channels) {
-    json.key(name).begin_object();
-    json.field("type", c.type.empty() ? std::optional<std::string>() : c.type);
-    json.field("count", c.count);
-    json.field("rate_hz", c.rate_hz);
-    json.field("max_gap_s", c.max_gap_s);
-    json.field("backwards", c.backwards);
-    json.field("event_backwards", c.event_backwards);
-    json.field("utime_backwards", c.utime_backwards);
-    json.field("max_backstep_s", c.max_backstep_s);
-    json.field("seq_gaps", c.seq_gaps);
-    json.field("seq_restarts", c.seq_restarts);
-    json.field("decode_failures", c.decode_failures);
-    json.field("unknown_fingerprint", c.unknown_fingerprint);
-    json.field("undecodable", c.undecodable);
-    json.key("other_types").begin_object();
-    for (const auto& [type, n] : c.other_types) json.field(type, n);
-    json.end_object();
-    json.field("rejected", c.rejected);
-    json.field("stamp_outliers", c.stamp_outliers);
-    json.field("time_jumps", c.time_jumps);
-    auto opt = [](const Range& r, int64_t v) { return r.empty ? std::optional<int64_t>() : v; };
-    json.field("points_per_scan_min", opt(c.points, c.points.min));
-    json.field("points_per_scan_max", opt(c.points, c.points.max));
-    auto secs = [](const Range& r, int64_t v) {
-      return r.empty ? std::optional<double>() : 1e-6 * static_cast<double>(v);
+    Json j;
+    j["type"] = c.type.empty() ? Json() : Json(c.type);
+    j["count"] = c.count;
+    j["rate_hz"] = figure(c.rate_hz);
+    j["max_gap_s"] = figure(c.max_gap_s);
+    j["backwards"] = c.backwards;
+    j["event_backwards"] = c.event_backwards;
+    j["utime_backwards"] = c.utime_backwards;
+    j["max_backstep_s"] = figure(c.max_backstep_s);
+    j["seq_gaps"] = c.seq_gaps;
+    j["seq_restarts"] = c.seq_restarts;
+    j["decode_failures"] = c.decode_failures;
+    j["unknown_fingerprint"] = c.unknown_fingerprint;
+    j["undecodable"] = c.undecodable;
+    j["other_types"] = Json::object();
+    for (const auto& [type, n] : c.other_types) j["other_types"][type] = n;
+    j["rejected"] = c.rejected;
+    j["stamp_outliers"] = c.stamp_outliers;
+    j["time_jumps"] = c.time_jumps;
+    const auto range = [](const Range& r, int64_t v) { return r.empty ? Json() : Json(v); };
+    j["points_per_scan_min"] = range(c.points, c.points.min);
+    j["points_per_scan_max"] = range(c.points, c.points.max);
+    const auto seconds = [](const Range& r, int64_t v) {
+      return r.empty ? Json() : figure(1e-6 * static_cast<double>(v));
     };
-    json.field("sweep_s_min", secs(c.sweep_us, c.sweep_us.min));
-    json.field("sweep_s_max", secs(c.sweep_us, c.sweep_us.max));
-    json.field("period_s", c.period_s);
-    json.key("frames").begin_array();
-    for (const auto& f : c.frames) json.value(f);
-    json.end_array();
-    json.field("first_utime", c.first_event_utime);
-    json.field("last_utime", c.last_event_utime);
-    json.end_object();
+    j["sweep_s_min"] = seconds(c.sweep_us, c.sweep_us.min);
+    j["sweep_s_max"] = seconds(c.sweep_us, c.sweep_us.max);
+    j["period_s"] = figure(c.period_s);
+    j["frames"] = c.frames;
+    j["first_utime"] = c.first_event_utime;
+    j["last_utime"] = c.last_event_utime;
+    out[name] = std::move(j);
   }
-  json.end_object();
+  return out;
 }
 
-void write_processes(JsonWriter& json, const ProcessSummaries& processes) {
-  json.key("processes").begin_object();
+Json processes_json(const ProcessSummaries& processes) {
+  Json out = Json::object();
   for (const auto& [name, p] : processes) {
-    json.key(name).begin_object();
-    json.field("channel", p.channel);
-    json.field("state", p.state);
-    json.field("last_state", p.last.state);
-    json.field("host", p.last.host);
-    json.field("pid", static_cast<int64_t>(p.last.pid));
-    json.field("statuses", p.statuses);
-    json.field("silent_s", p.silent_s);
-    json.field("max_status_gap_s", p.max_status_gap_s);
-    json.field("status_seq_gaps", p.status_seq_gaps);
-    json.field("restarts", p.restarts);
-    json.field("uptime_s", p.last.uptime_s);
-    json.field("cpu_s", p.last.cpu_s);
-    json.field("rss_bytes", p.last.rss_bytes);
-    json.field("peak_rss_bytes", p.peak_rss_bytes);
-    json.field("received", p.last.received);
-    json.field("published", p.last.published);
-    json.field("decode_failures", p.last.decode_failures);
-    json.field("out_of_order", p.last.out_of_order);
-    json.field("missed", p.last.missed);
-    json.field("handler_errors", p.last.handler_errors);
-    json.field("rejected", p.last.rejected);
-    json.field("stamp_outliers", p.last.stamp_outliers);
-    json.field("queue_dropped", p.last.queue_dropped);
-    json.end_object();
+    Json j;
+    j["channel"] = p.channel;
+    j["state"] = p.state;
+    j["last_state"] = p.last.state;
+    j["host"] = p.last.host;
+    j["pid"] = p.last.pid;
+    j["statuses"] = p.statuses;
+    j["silent_s"] = figure(p.silent_s);
+    j["max_status_gap_s"] = figure(p.max_status_gap_s);
+    j["status_seq_gaps"] = p.status_seq_gaps;
+    j["restarts"] = p.restarts;
+    j["uptime_s"] = figure(p.last.uptime_s);
+    j["cpu_s"] = figure(p.last.cpu_s);
+    j["rss_bytes"] = p.last.rss_bytes;
+    j["peak_rss_bytes"] = p.peak_rss_bytes;
+    j["received"] = p.last.received;
+    j["published"] = p.last.published;
+    j["decode_failures"] = p.last.decode_failures;
+    j["out_of_order"] = p.last.out_of_order;
+    j["missed"] = p.last.missed;
+    j["handler_errors"] = p.last.handler_errors;
+    j["rejected"] = p.last.rejected;
+    j["stamp_outliers"] = p.last.stamp_outliers;
+    j["queue_dropped"] = p.last.queue_dropped;
+    out[name] = std::move(j);
   }
-  json.end_object();
-}
-
-void write_problems(JsonWriter& json, const std::vector<std::string>& problems) {
-  json.key("problems").begin_array();
-  for (const auto& p : problems) json.value(p);
-  json.end_array();
+  return out;
 }
 
 std::string channel_table(const ChannelSummaries& channels) {

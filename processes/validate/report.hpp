@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "json_writer.hpp"
+#include "json.hpp"
 #include "process_tracker.hpp"
 #include "stream_analyzer.hpp"
 
@@ -31,12 +31,10 @@ struct Thresholds {
 std::vector<std::string> process_problems(const ProcessSummaries& processes,
                                           const Thresholds& t = {});
 
-// Writes the key "channels" and an object with one entry per channel.
-void write_channels(JsonWriter& json, const ChannelSummaries& channels);
-// Writes the key "processes" and an object with one entry per process.
-void write_processes(JsonWriter& json, const ProcessSummaries& processes);
-// Writes the key "problems" and the list.
-void write_problems(JsonWriter& json, const std::vector<std::string>& problems);
+// The JSON of the summaries: an object with one entry per channel, per process. Times in s,
+// rates in Hz, memory in bytes, counts in messages; a figure that cannot be known is null.
+Json channels_json(const ChannelSummaries& channels);
+Json processes_json(const ProcessSummaries& processes);
 
 // Human-readable tables, one line per channel or process (plus detail lines), ending in '\n'.
 std::string channel_table(const ChannelSummaries& channels);

@@ -1,10 +1,27 @@
 #include "run_summary.hpp"
 
+#include <cmath>
+
 namespace traverse::validate {
 
 void judge(RunSummary& s, const Thresholds& t) {
-  s.problems = channel_problems(s.channels);
   s.notes.clear();
+  // Live, a message's event time is when the monitor's socket received it, by the machine's wall
+  // clock, and two messages received within a fraction of a millisecond can be stamped the wrong
+  // way round; the stream itself went backwards only where the messages' own times did. A step
+  // back of the receive time alone is therefore said, not a verdict (a log's event times are
+  // judged: they are what a replay delivers by).
+  ChannelSummaries judged = s.channels;
+  for (auto& [name, c] : judged) {
+    const int64_t receive_only = c.backwards - c.utime_backwards;
+    if (!t.timing || receive_only <= 0) continue;
+    s.notes.push_back(name + ": received " + std::to_string(receive_only) +
+                      " messages stamped earlier than the one before (up to " +
+                      std::to_string(std::lround(1e6 * c.max_backstep_s.value_or(0.0))) +
+                      " us), their own times in order");
+    c.backwards = c.utime_backwards;
+  }
+  s.problems = channel_problems(judged);
   // The monitor listens like any process; on a loaded machine its own socket can overflow while
   // every process of the graph keeps up (each counts what it missed: process_problems below).
   // Its own misses are therefore said, not a verdict on the run.
@@ -24,24 +41,19 @@ void judge(RunSummary& s, const Thresholds& t) {
 }
 
 std::string to_json(const RunSummary& s) {
-  JsonWriter json;
-  json.begin_object();
-  json.field("lcm_url", s.lcm_url);
-  json.field("start_utime", s.start_utime);
-  json.field("end_utime", s.end_utime);
-  json.field("duration_s", 1e-6 * static_cast<double>(s.end_utime - s.start_utime));
-  json.field("events", s.events);
-  json.field("status_decode_failures", s.status_decode_failures);
-  write_channels(json, s.channels);
-  write_processes(json, s.processes);
-  write_problems(json, s.problems);
-  json.key("notes");
-  json.begin_array();
-  for (const auto& n : s.notes) json.value(n);
-  json.end_array();
-  json.field("ok", s.ok);
-  json.end_object();
-  return json.str();
+  Json j;
+  j["lcm_url"] = s.lcm_url;
+  j["start_utime"] = s.start_utime;
+  j["end_utime"] = s.end_utime;
+  j["duration_s"] = json_significant(1e-6 * static_cast<double>(s.end_utime - s.start_utime), 9);
+  j["events"] = s.events;
+  j["status_decode_failures"] = s.status_decode_failures;
+  j["channels"] = channels_json(s.channels);
+  j["processes"] = processes_json(s.processes);
+  j["problems"] = s.problems;
+  j["notes"] = s.notes;
+  j["ok"] = s.ok;
+  return json_line(j);
 }
 
 std::string to_text(const RunSummary& s) {

@@ -16,21 +16,29 @@ duration_s=60
 out="$(mktemp /tmp/traverse-bench-sim.XXXXXX.lcmlog)"
 trap 'rm -f "$out"' EXIT
 TIMEFORMAT='%R %U %S'
-json=""
+rows=()
 for profile in ideal realistic; do
   timing=$( { time "$BIN" --config configs/sim.yaml --world configs/worlds/office.yaml \
     --route configs/routes/office-s2.yaml --seed 1 --profile "$profile" --duration "$duration_s" \
     --out "$out" > /dev/null 2>&1; } 2>&1 )
   read -r wall_s user_s sys_s <<< "$timing"
-  bytes=$(stat -c %s "$out")
-  json+=$(awk -v p="$profile" -v d="$duration_s" -v w="$wall_s" -v u="$user_s" -v s="$sys_s" -v b="$bytes" 'BEGIN {
-    cpu = u + s
-    printf "%s: generated %d s of office-s2 (seed 1): wall time %.2f s, CPU time %.2f s, log %.1f MB; real_time_factor %.2f, %.2f per CPU s\n", p, d, w, cpu, b / 1e6, d / w, d / cpu > "/dev/stderr"
-    printf "\"%s\":{\"wall_s\":%.3f,\"cpu_s\":%.3f,\"real_time_factor\":%.3f,\"cpu_real_time_factor\":%.3f,\"log_bytes\":%d},", p, w, cpu, d / w, d / cpu, b
-  }')
+  rows+=("$profile $wall_s $user_s $sys_s $(stat -c %s "$out")")
 done
-cpu_ideal=$(sed 's/.*"ideal":{[^}]*"cpu_s":\([0-9.]*\).*/\1/' <<< "$json")
-cpu_real=$(sed 's/.*"realistic":{[^}]*"cpu_s":\([0-9.]*\).*/\1/' <<< "$json")
-ratio=$(awk -v a="$cpu_real" -v b="$cpu_ideal" 'BEGIN { printf "%.3f", a / b }')
-echo "realistic over ideal, CPU time: ${ratio}x" >&2
-echo "{\"bench\":\"sim\",\"route\":\"office-s2\",\"seed\":1,\"sim_duration_s\":$duration_s,${json}\"cpu_ratio\":$ratio}"
+# The figures, the summary lines and the JSON object (built by json, read by nothing but parsers).
+python3 - "$duration_s" "${rows[@]}" <<'PY'
+import json, sys
+duration_s, out = int(sys.argv[1]), {"bench": "sim", "route": "office-s2", "seed": 1}
+out["sim_duration_s"] = duration_s
+for row in sys.argv[2:]:
+    profile, wall, user, system, size = row.split()
+    wall, cpu, size = float(wall), float(user) + float(system), int(size)
+    print(f"{profile}: generated {duration_s:.0f} s of office-s2 (seed 1): wall time {wall:.2f} s, "
+          f"CPU time {cpu:.2f} s, log {size / 1e6:.1f} MB; real_time_factor {duration_s / wall:.2f}, "
+          f"{duration_s / cpu:.2f} per CPU s", file=sys.stderr)
+    out[profile] = {"wall_s": round(wall, 3), "cpu_s": round(cpu, 3),
+                    "real_time_factor": round(duration_s / wall, 3),
+                    "cpu_real_time_factor": round(duration_s / cpu, 3), "log_bytes": size}
+out["cpu_ratio"] = round(out["realistic"]["cpu_s"] / out["ideal"]["cpu_s"], 3)
+print(f"realistic over ideal, CPU time: {out['cpu_ratio']:.3f}x", file=sys.stderr)
+print(json.dumps(out))
+PY

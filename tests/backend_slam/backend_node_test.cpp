@@ -6,6 +6,7 @@
 
 #include "drive_feed.hpp"
 #include "traverse/key_poses_t.hpp"
+#include "traverse/pose_graph_edges_t.hpp"
 
 namespace traverse::backend {
 namespace {
@@ -20,6 +21,8 @@ class BackendNodeTest : public ::testing::Test {
                                 [this](const key_poses_t& m) { messages_.push_back(m); });
     bus_.subscribe<pose2d_t>(channels::kPoseBackend,
                              [this](const pose2d_t& m) { trajectory_.push_back(m); });
+    bus_.subscribe<pose_graph_edges_t>(
+        channels::kPoseGraphEdges, [this](const pose_graph_edges_t& m) { edges_.push_back(m); });
     const test::Drive d = test::drive_ellipse(duration_s);
     for (std::size_t k = 0; k < d.utimes.size(); ++k) {
       test::publish_drive_step(bus_, d, k);
@@ -29,6 +32,7 @@ class BackendNodeTest : public ::testing::Test {
     handle_all();
     node.report_counters();
     key_poses_ = static_cast<int>(node.backend().key_poses().size());
+    for (const KeyPose& k : node.backend().key_poses()) key_utimes_.push_back(k.utime);
   }
   void handle_all() {
     while (bus_.lcm().handleTimeout(0) > 0) {
@@ -39,6 +43,8 @@ class BackendNodeTest : public ::testing::Test {
   std::map<std::string, double> counters_;
   std::vector<key_poses_t> messages_;
   std::vector<pose2d_t> trajectory_;
+  std::vector<pose_graph_edges_t> edges_;
+  std::vector<int64_t> key_utimes_;
   int key_poses_ = 0;
 };
 
@@ -87,6 +93,37 @@ TEST_F(BackendNodeTest, LoopClosuresRepublishMovedPosesInBoundedParts) {
   EXPECT_EQ(closures, counters_.at("loop_closures"));
   EXPECT_GT(multipart, 0);  // a closure moved more than 10 key poses
   EXPECT_GT(counters_.at("optimisation_total_s"), 0.0);
+}
+
+// With the drift model the graph holds the drifting frontend's poses besides the key poses; the
+// edges published name key poses only (before: graph vertex indices, twice the key pose ids,
+// read as key ids by the annotator and past the end of the key poses by the node itself).
+TEST_F(BackendNodeTest, PublishedEdgesNameKeyPosesOnlyWithTheDriftModel) {
+  BackendNodeConfig config;
+  // This frontend drifts by 3 % of the travel and 0.01 rad per metre.
+  config.backend.frontend_drift_length_m = 1.0;
+  config.backend.frontend_sigma_xy_m = 0.03;
+  config.backend.frontend_sigma_theta_rad = 0.02;
+  run(config, 18.0);
+  ASSERT_GT(counters_.at("loop_closures"), 0.0);
+  int expected_index = 0, frontend = 0, closures = 0;
+  for (const pose_graph_edges_t& m : edges_) {
+    EXPECT_EQ(m.first_index, expected_index);
+    for (const pose_graph_edge_t& e : m.edges) {
+      EXPECT_EQ(e.index, expected_index++);
+      ASSERT_GE(e.from_id, 0);
+      ASSERT_LT(e.to_id, key_poses_);
+      EXPECT_LT(e.from_id, e.to_id);
+      EXPECT_EQ(e.utime, key_utimes_[static_cast<std::size_t>(e.to_id)]);
+      if (e.kind == pose_graph_edge_t::KIND_FRONTEND) {
+        EXPECT_EQ(e.to_id, e.from_id + 1);
+        ++frontend;
+      }
+      if (e.kind == pose_graph_edge_t::KIND_LOOP_CLOSURE) ++closures;
+    }
+  }
+  EXPECT_EQ(frontend, key_poses_ - 1);  // one per key step
+  EXPECT_EQ(closures, counters_.at("loop_closures"));
 }
 
 }  // namespace

@@ -206,6 +206,31 @@ TEST(Backend, OdometryReplacesAFrontendStepItContradicts) {
   EXPECT_LT(error_with, 0.05);    // [m]
 }
 
+// Odometry whose readings lag (Kummerle's intel: ODOM stamps in bursts) contradicts a right
+// frontend step by 0.15 m; the link matched around the odometry's step ends where the one around
+// the frontend's did, with a response higher by the grid's luck. Before, that response alone
+// replaced the frontend's step, and the rest of intel's run turned by 1.5 degrees; the scans side
+// with the odometry only where their match lies at its step and away from the frontend's.
+TEST(OdometryCheck, ScansSideWithTheOdometryOnlyWhereTheirMatchLiesAtItsStep) {
+  OdometryStep odometry;
+  odometry.motion = Pose2(0.012, 0.0, 0.0);
+  odometry.covariance = Eigen::Vector3d(4e-4, 4e-4, 4e-4).asDiagonal();
+  const Pose2 frontend(0.163, -0.006, 0.004);
+  const Eigen::Matrix3d frontend_covariance = Eigen::Vector3d(1e-5, 1e-5, 1e-6).asDiagonal();
+  const Eigen::Matrix3d match_covariance = Eigen::Vector3d(2e-4, 2e-4, 4e-5).asDiagonal();
+  const double gate = OdometryCheckConfig{}.max_frontend_chi2;
+  // The match at the frontend's step: no verdict for the odometry, however it scores.
+  EXPECT_FALSE(scans_side_with_odometry(odometry, frontend, frontend_covariance,
+                                        Pose2(0.155, 0.002, 0.0), match_covariance, 0.81, 0.80,
+                                        gate));
+  // At the odometry's step and scoring better: the scans side with it.
+  EXPECT_TRUE(scans_side_with_odometry(odometry, frontend, frontend_covariance,
+                                       Pose2(0.02, 0.0, 0.0), match_covariance, 0.81, 0.80, gate));
+  // ... but not scoring better.
+  EXPECT_FALSE(scans_side_with_odometry(odometry, frontend, frontend_covariance,
+                                        Pose2(0.02, 0.0, 0.0), match_covariance, 0.79, 0.80, gate));
+}
+
 TEST(OdometryCheck, InterpolatesBetweenReadingsAndKnowsItsGaps) {
   OdometryCheck check{OdometryCheckConfig{}};
   check.add(1'000'000, Pose2(0.0, 0.0, 0.0));

@@ -17,6 +17,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -225,11 +226,13 @@ Result run(const Log& log, const std::vector<FrontendPose>& frontend, const Back
 struct LogCase {
   const char* name;
   friend void PrintTo(const LogCase& c, std::ostream* os) { *os << c.name; }
-  // Closures over 5 sigmas from the reference (evaluator: false_closure_sigmas) allowed, and the
-  // full graph's RPE over 10 m at most this many times the frontend's. The goal is 0 and 1; the
-  // measured gaps are held here so that they cannot grow (see the cases below).
+  // Closures over 5 sigmas from the reference (evaluator: false_closure_sigmas) allowed, the
+  // full graph's RPE over 10 m and its position RMSE at most these many times the frontend's.
+  // The goal is 0, 1 and 1; a measured gap is held here so that it cannot grow (see the cases
+  // below).
   std::size_t max_false_closures = 0;
   double max_rpe_10m_ratio = 1.0;
+  double max_position_rmse_ratio = 1.0;
 };
 
 class CarmenBackend : public ::testing::TestWithParam<LogCase> {};
@@ -265,7 +268,7 @@ TEST_P(CarmenBackend, FullGraphNoWorseThanFrontendAndNoFalseClosure) {
   ASSERT_TRUE(f.rpe_10m.rms_m && g.rpe_10m.rms_m && f.rpe_1m.rms_m && g.rpe_1m.rms_m);
   std::printf(
       "%s: %zu key poses, %zu closures (%zu false); frontend / full graph: RPE over 1 m %.4f / "
-      "%.4f m, over 10 m %.4f / %.4f m, position RMSE %.3f / %.3f m, heading RMSE %.2f / %.2f "
+      "%.4f m, over 10 m %.4f / %.4f m, position RMSE %.4f / %.4f m, heading RMSE %.2f / %.2f "
       "deg\n",
       name.c_str(), r.key_poses, r.closures.closures, r.closures.false_closures, *f.rpe_1m.rms_m,
       *g.rpe_1m.rms_m, *f.rpe_10m.rms_m, *g.rpe_10m.rms_m, f.position_m.rmse, g.position_m.rmse,
@@ -275,15 +278,30 @@ TEST_P(CarmenBackend, FullGraphNoWorseThanFrontendAndNoFalseClosure) {
     std::printf("  %s edges: %zu, NEES median %.2f, outside the 99 %% ellipsoid %.1f %%\n", kind,
                 c.edges, c.nees_median, 100.0 * c.outside_99_fraction);
   }
+  // A closure flagged against the reference: is it the closure or the reference? The frontend's
+  // own relative pose between the same two scans (it never saw the closure) is printed beside it,
+  // with the same sign convention (T_true against the measurement).
+  std::map<int64_t, Pose2> frontend_at;
+  for (const FrontendPose& p : frontend) frontend_at.emplace(p.utime, p.T_map_base);
   for (const evaluator::ClosureCheck& c : r.closures.checks) {
     if (!c.is_false && !std::getenv("TRAVERSE_TRACE_CLOSURES")) continue;
+    Eigen::Vector3d frontend_error = Eigen::Vector3d::Constant(NAN);
+    const auto a = frontend_at.find(c.closure.from_utime), b = frontend_at.find(c.closure.to_utime);
+    if (c.matched && a != frontend_at.end() && b != frontend_at.end()) {
+      const Pose2 E = between(between(a->second, b->second), c.T_true);
+      frontend_error = Eigen::Vector3d(E.x(), E.y(), wrap_angle(E.theta()));
+    }
     std::printf(
         "  closure %lld -> %lld%s: error %.3f %.3f m %.4f rad, sigma %.3f %.3f m %.4f rad, "
-        "mahalanobis %.1f, chi2 increase %.1f\n",
+        "mahalanobis %.1f, chi2 increase %.1f; the frontend's error between the same scans "
+        "%.3f %.3f m %.4f rad\n",
         static_cast<long long>(c.closure.from_id), static_cast<long long>(c.closure.to_id),
         c.is_false ? " FALSE" : "", c.error.x(), c.error.y(), c.error.z(), c.sigma.x(), c.sigma.y(),
-        c.sigma.z(), c.mahalanobis.value_or(-1.0), r.chi2_increase.at(c.closure.to_id));
+        c.sigma.z(), c.mahalanobis.value_or(-1.0), r.chi2_increase.at(c.closure.to_id),
+        frontend_error.x(), frontend_error.y(), frontend_error.z());
   }
+  std::printf("  ratios, full graph against frontend: RPE over 10 m %.4f, position RMSE %.4f\n",
+              *g.rpe_10m.rms_m / *f.rpe_10m.rms_m, g.position_m.rmse / f.position_m.rmse);
   std::printf("  largest step turn of the full graph beside the frontend's: %.3f rad\n",
               r.max_turn_difference_rad);
   EXPECT_LE(r.closures.false_closures, log_case.max_false_closures);
@@ -291,25 +309,34 @@ TEST_P(CarmenBackend, FullGraphNoWorseThanFrontendAndNoFalseClosure) {
   // No key pose flips its heading: every step of the full graph turns within 0.2 rad of the
   // frontend's (key poses flipped by 20-180 degrees before).
   EXPECT_LT(r.max_turn_difference_rad, 0.2);
-  // No collapse against the reference (before: intel 12.3 m, aces 72.8 m, freiburg-079 25.1 m
-  // against 0.53, 1.42 and 0.09 m for the frontend alone); csail's full graph is 0.154 m against
-  // the frontend's 0.083 m.
-  EXPECT_LT(g.position_m.rmse, 2.0 * f.position_m.rmse);
+  // Before issue 20 the graph collapsed against the reference (intel 12.3 m, aces 72.8 m,
+  // freiburg-079 25.1 m against 0.53, 1.42 and 0.09 m for the frontend alone).
+  EXPECT_LE(g.position_m.rmse, log_case.max_position_rmse_ratio * f.position_m.rmse);
   EXPECT_LT(g.heading_rad.rmse, 1.1 * f.heading_rad.rmse);
 }
 
-// Measured (configs/backend.yaml, the snapshots of the frontend in tests/backend_slam/frontend),
-// full graph against frontend alone, RPE over 10 m: intel 0.1092 / 0.1271 m, aces 0.1434 /
-// 0.1454 m, csail 0.1441 / 0.1442 m, freiburg-079 0.0983 / 0.0982 m. False closures: intel 2 of
-// 87, aces 0 of 10, csail 0 of 7, freiburg-079 6 of 117 (with a drift length of 10 m: 1 and 5,
-// but csail's position RMSE through the graph 0.094 m against the frontend's 0.083 m). Five of
-// freiburg-079's six lie between keys 233-250 and 651-707 and err by 0.04-0.06 rad in heading
-// against the reference; the frontend alone, over its whole path between those key poses,
-// differs from the reference's relative heading by the same 0.05 rad: the reference, not the
-// closures, may be off there.
+// Measured 2026-11-27 (configs/backend.yaml; the snapshots made that day from the frontend with
+// wheel odometry as its motion prior), full graph against frontend alone: RPE over 10 m / position
+// RMSE, closures (false): intel 0.0940 / 0.0985, 0.168 / 0.340 m, 86 (0); aces 0.1114 / 0.1196,
+// 0.188 / 1.517 m, 10 (0); csail 0.1455 / 0.1463, 0.0887 / 0.0817 m, 8 (0); freiburg-079
+// 0.1011 / 0.1011 (ratio 0.9998), 0.0853 / 0.0847 m (ratio 1.008), 118 (6).
+// csail's position RMSE is 8.6 % above the frontend's, held at that: its closures agree with the
+// reference (NEES median 0.78) and with the frontend's own relative poses (within 0.4 degrees and
+// 3 cm, through the graph offline 2026-11-26), yet the graph, weighing them against the links
+// and the frontend's steps, turns off the frontend by 0.1-0.3 degrees from the first closure on;
+// without closures and without links the full graph reproduces the frontend (0.0817 m).
+// freiburg-079's six flagged closures (over 5 sigmas from the reference) are held at six, not
+// passed: each agrees with the frontend's own relative pose between the same two scans, which
+// never saw the closure (heading within 0.004-0.008 rad, position within 1-2 cm), while the
+// reference differs from both by 0.05-0.06 rad (five of them, keys 234-250 to 651-717) and by
+// 0.012 rad and 14 cm (135 to 1917); the closures add less than 1 to the graph's chi2. Two
+// independent estimates against one: the reference, not the closures, is the likelier to be
+// off there (not checked against Kummerle's fr079 relations: that log's stamps differ from this
+// one's, and tying the two would need their scans matched).
 INSTANTIATE_TEST_SUITE_P(Logs, CarmenBackend,
-                         ::testing::Values(LogCase{"intel", 2}, LogCase{"aces"}, LogCase{"csail"},
-                                           LogCase{"freiburg-079", 6, 1.002}),
+                         ::testing::Values(LogCase{"intel"}, LogCase{"aces"},
+                                           LogCase{"csail", 0, 1.0, 1.09},
+                                           LogCase{"freiburg-079", 6, 1.0, 1.01}),
                          [](const auto& info) {
                            std::string n = info.param.name;
                            for (char& ch : n)

@@ -78,6 +78,43 @@ TEST(CorrelativeMatcher, PenaltyPullsAnUnconstrainedMatchToTheGuess) {
   EXPECT_NEAR(m.T_world_query.x(), 0.25, 0.031);
 }
 
+TEST(CorrelativeMatcher, SecondPeakAboveAShareIsFoundWithLessWork) {
+  // Along a corridor a pose 0.3 m away fits almost as well as the best: the second peak is high.
+  std::mt19937 rng(7);
+  const World world = test::synthetic::corridor(60.0, 2.4);
+  std::vector<Eigen::Vector2d> reference;
+  for (const auto& p : test::key_points(world, Pose2(), 20.0, rng)) {
+    reference.push_back(p.cast<double>());
+  }
+  const auto query = test::to_double(test::key_points(world, Pose2(0.0, 0.3, 0.0), 20.0, rng));
+  const CorrelativeMatcher matcher(wide());
+  const Pose2 guess(0.1, 0.35, 0.02);
+  const MatchResult all = matcher.match(reference, query, guess, 0.3);
+  ASSERT_TRUE(all.valid);
+  const double share = all.second_peak_response / all.raw_response;
+  EXPECT_GT(share, 0.85);
+  // Asked only above a share below it: the same peak; above it: none.
+  const MatchResult below = matcher.match(reference, query, guess, 0.3, share - 0.05);
+  EXPECT_DOUBLE_EQ(below.second_peak_response, all.second_peak_response);
+  const MatchResult above = matcher.match(reference, query, guess, 0.3, share + 0.01);
+  EXPECT_EQ(above.second_peak_response, 0.0);
+  // In a room the second peak is low: a floor at 85 % of the peak skips most of the search.
+  const Case room{test::synthetic::room(), Pose2(0.8, 0.5, 0.3), Pose2(0.2, -0.1, 0.05)};
+  std::vector<Eigen::Vector2d> room_reference;
+  for (const auto& p : test::key_points(room.world, Pose2(), 20.0, rng)) {
+    room_reference.push_back(p.cast<double>());
+  }
+  const auto room_query =
+      test::to_double(test::key_points(room.world, room.T_world_true, 20.0, rng));
+  const Pose2 room_guess = room.T_world_true * room.guess_error;
+  const MatchResult room_all = matcher.match(room_reference, room_query, room_guess, 0.3);
+  const MatchResult room_floor = matcher.match(room_reference, room_query, room_guess, 0.3, 0.85);
+  EXPECT_LT(room_all.second_peak_response, 0.85 * room_all.raw_response);
+  EXPECT_EQ(room_floor.second_peak_response, 0.0);
+  EXPECT_LT(room_floor.evaluations, room_all.evaluations);
+  EXPECT_EQ(room_floor.T_world_query.vector(), room_all.T_world_query.vector());
+}
+
 TEST(CorrelativeMatcher, EmptyInputIsInvalid) {
   const CorrelativeMatcher matcher{CorrelativeMatcherConfig{}};
   EXPECT_FALSE(matcher.match({}, {{1.0, 0.0}}, Pose2()).valid);

@@ -23,6 +23,32 @@ namespace {
 
 namespace fe = frontend;
 
+// The block bound is the largest cell of each k x k block, cut at the table's edges: the same
+// as taking it cell by cell, for blocks wider than the table and tables not a multiple of k.
+TEST(CorrelativeSearch, BlockBoundIsTheLargestCellOfEachBlock) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> value(0.0f, 1.0f);
+  for (const auto& [w, h] :
+       {std::pair{37, 23}, std::pair{8, 8}, std::pair{1, 5}, std::pair{3, 1}}) {
+    correlative::ScoreTable table(w, h);
+    for (int j = 0; j < h; ++j) {
+      for (int i = 0; i < w; ++i) table.at(i, j) = value(rng);
+    }
+    for (const int k : {1, 2, 3, 8, 40}) {
+      const correlative::BlockBound bound(table, k);
+      for (int j = 0; j < h; ++j) {
+        for (int i = 0; i < w; ++i) {
+          float m = 0.0f;
+          for (int jj = j; jj < std::min(j + k, h); ++jj) {
+            for (int ii = i; ii < std::min(i + k, w); ++ii) m = std::max(m, table.at(ii, jj));
+          }
+          ASSERT_EQ(bound.at(i, j), m) << w << "x" << h << " k " << k << " at " << i << ", " << j;
+        }
+      }
+    }
+  }
+}
+
 // Branch and bound over blocks of 4 x 4 (with a prior that is a valid bound) finds the pose an
 // exhaustive search finds, with the same score, scoring far fewer poses; a margin makes it score
 // every pose within the margin of the best.

@@ -202,10 +202,20 @@ struct WalkCase {
   int time_limit_s = 60;
   // A program that runs until stopped gets SIGINT after this long (0: it ends by itself).
   double stop_after_s = 0.0;
+  // Keys under a prefix walked otherwise: on the smallest inputs that exercise them (instead of
+  // `inputs`), with `set` added to every trial and to the shipped config's run (e.g. the kind of
+  // frontend whose keys they are). The first part whose prefix a key's path starts with.
+  struct Part {
+    std::vector<std::string> prefixes;  // e.g. "icp."
+    std::vector<std::string> inputs;
+    std::vector<Assignment> set;
+  };
+  std::vector<Part> parts;
 };
 
 struct WalkSummary {
   int trials = 0, refused = 0, ran = 0;
+  int runs = 0;  // programs started
 };
 
 // Runs every trial of Config's keys (see the header); GoogleTest failures name the trial.
@@ -219,6 +229,25 @@ WalkSummary walk_config(const WalkCase& c) {
   const std::string program = std::string(TRAVERSE_BIN_DIR) + "/" + c.program;
   const std::string config_file = c.work_dir + "/" + c.program + "-trial.yaml";
   const std::string err_file = c.work_dir + "/" + c.program + "-trial.err";
+  // Where each trial runs: the part its first key falls in, or the whole inputs.
+  const WalkCase::Part whole{{}, c.inputs, {}};
+  const auto part_of = [&](const Trial& t) -> const WalkCase::Part& {
+    for (const WalkCase::Part& p : c.parts) {
+      for (const std::string& prefix : p.prefixes) {
+        if (t.set.front().path.rfind(prefix, 0) == 0) return p;
+      }
+    }
+    return whole;
+  };
+  const auto write_config = [&](const std::vector<Assignment>& base, const Trial* t) {
+    YAML::Node root = YAML::LoadFile(c.shipped_config);
+    for (const Assignment& a : base) set_path(root, a.path, a.value);
+    if (t) {
+      for (const Assignment& a : t->set) set_path(root, a.path, a.value);
+    }
+    std::ofstream out(config_file);
+    out << YAML::Dump(root) << "\n";
+  };
   const auto run = [&](const std::string& input) {
     std::string command = "timeout -s KILL " + std::to_string(c.time_limit_s) + " ";
     if (c.stop_after_s > 0.0) {
@@ -226,26 +255,25 @@ WalkSummary walk_config(const WalkCase& c) {
     }
     return run_command(command + program + " --config " + config_file + " " + input, err_file);
   };
-  const auto run_all = [&](const std::string& what) {
-    for (const std::string& input : c.inputs) {
+  // The shipped config itself runs on every input of every part (or the walk shows nothing).
+  std::vector<const WalkCase::Part*> all_parts{&whole};
+  for (const WalkCase::Part& p : c.parts) all_parts.push_back(&p);
+  for (const WalkCase::Part* p : all_parts) {
+    write_config(p->set, nullptr);
+    for (const std::string& input : p->inputs) {
       const RunResult r = run(input);
-      EXPECT_EQ(r.exit_code, 0) << c.program << " " << what << " on " << input << ":\n" << r.err;
+      EXPECT_EQ(r.exit_code, 0) << c.program << " as shipped on " << input << ":\n" << r.err;
+      ++summary.runs;
     }
-  };
-  // The shipped config itself runs on every input (or the walk shows nothing).
-  std::filesystem::copy_file(c.shipped_config, config_file,
-                             std::filesystem::copy_options::overwrite_existing);
-  run_all("as shipped");
+  }
   for (const Trial& t : trials(keys)) {
     ++summary.trials;
-    YAML::Node root = YAML::LoadFile(c.shipped_config);
-    for (const Assignment& a : t.set) set_path(root, a.path, a.value);
-    {
-      std::ofstream out(config_file);
-      out << YAML::Dump(root) << "\n";
-    }
+    const WalkCase::Part& part = part_of(t);
+    const std::vector<std::string>& inputs = part.inputs;
+    write_config(part.set, &t);
     // Refused at start (no input needed): exit 2 naming a key it set and the file.
-    const RunResult r = run(c.inputs[0]);
+    const RunResult r = run(inputs[0]);
+    ++summary.runs;
     if (r.exit_code == 2) {
       ++summary.refused;
       bool named = false;
@@ -270,17 +298,19 @@ WalkSummary walk_config(const WalkCase& c) {
       continue;
     }
     ++summary.ran;
-    EXPECT_EQ(r.exit_code, 0) << c.program << " " << t.what << " on " << c.inputs[0] << ":\n"
+    EXPECT_EQ(r.exit_code, 0) << c.program << " " << t.what << " on " << inputs[0] << ":\n"
                               << r.err;
     if (r.exit_code != 0) continue;
-    for (std::size_t i = 1; i < c.inputs.size(); ++i) {
-      const RunResult ri = run(c.inputs[i]);
-      EXPECT_EQ(ri.exit_code, 0) << c.program << " " << t.what << " on " << c.inputs[i] << ":\n"
+    for (std::size_t i = 1; i < inputs.size(); ++i) {
+      const RunResult ri = run(inputs[i]);
+      ++summary.runs;
+      EXPECT_EQ(ri.exit_code, 0) << c.program << " " << t.what << " on " << inputs[i] << ":\n"
                                  << ri.err;
     }
   }
-  std::printf("%s: %zu numeric keys, %d trials: %d refused, %d ran\n", c.program.c_str(),
-              keys.size(), summary.trials, summary.refused, summary.ran);
+  std::printf("%s: %zu numeric keys, %d trials: %d refused, %d ran; %d program runs\n",
+              c.program.c_str(), keys.size(), summary.trials, summary.refused, summary.ran,
+              summary.runs);
   return summary;
 }
 

@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <regex>
 #include <string>
 #include <vector>
 
+#include "json.hpp"
 #include "messages.hpp"
 #include "publisher.hpp"
 #include "synthetic.hpp"
@@ -50,19 +50,15 @@ RunResult run(const std::string& args) {
   return r;
 }
 
-// The raw value of `key` in a flat one-line JSON object ("null", a number, or a quoted string).
-std::optional<std::string> json_value(const std::string& json, const std::string& key) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + key + "\": (\"[^\"]*\"|[^,}]+)"))) {
-    return std::nullopt;
-  }
-  return m[1].str();
+// The value of `key` in the program's one-line JSON summary (null when absent or not JSON).
+Json json_value(const std::string& json, const std::string& key) {
+  const Json j = Json::parse(json, nullptr, false);
+  return !j.is_discarded() && j.is_object() && j.contains(key) ? j[key] : Json();
 }
 
 double json_number(const std::string& json, const std::string& key) {
-  const auto v = json_value(json, key);
-  if (!v || *v == "null") return std::nan("");
-  return std::stod(*v);
+  const Json v = json_value(json, key);
+  return v.is_number() ? v.get<double>() : std::nan("");
 }
 
 class EvaluatorProgram : public ::testing::Test {
@@ -116,9 +112,9 @@ TEST_F(EvaluatorProgram, GroundTruthAgainstItselfIsZero) {
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
   for (const char* key : {"position_rmse_m", "position_sd_m", "position_max_m", "heading_rmse_deg",
                           "heading_sd_deg", "heading_max_deg", "rpe_1m_m", "max_jump_m"}) {
-    EXPECT_EQ(json_value(r.last_line, key), "0.000000") << key;
+    EXPECT_DOUBLE_EQ(json_number(r.last_line, key), 0.0) << key;
   }
-  EXPECT_EQ(json_value(r.last_line, "rpe_10m_m"), "null");  // 4 m of travel only
+  EXPECT_TRUE(json_value(r.last_line, "rpe_10m_m").is_null());  // 4 m of travel only
   EXPECT_EQ(json_number(r.last_line, "matched"), 2001);
   EXPECT_EQ(json_number(r.last_line, "unmatched"), 0);
   EXPECT_NEAR(json_number(r.last_line, "duration_s"), 10.0, 1e-9);
@@ -130,12 +126,12 @@ TEST_F(EvaluatorProgram, ShiftedGroundTruthShowsTheShift) {
                           " --estimate POSE_GROUND_TRUTH --align none --shift-estimate 0.3 -0.4 "
                           "0.01");
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
-  EXPECT_EQ(json_value(r.last_line, "position_rmse_m"), "0.500000");
-  EXPECT_EQ(json_value(r.last_line, "position_max_m"), "0.500000");
-  EXPECT_EQ(json_value(r.last_line, "position_sd_m"), "0.000000");
-  EXPECT_EQ(json_value(r.last_line, "heading_rmse_deg"), "0.572958");  // 0.01 rad
-  EXPECT_EQ(json_value(r.last_line, "heading_max_deg"), "0.572958");
-  EXPECT_EQ(json_value(r.last_line, "align"), "\"none\"");
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "position_rmse_m"), 0.5);
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "position_max_m"), 0.5);
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "position_sd_m"), 0.0);
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "heading_rmse_deg"), 0.572958);  // 0.01 rad
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "heading_max_deg"), 0.572958);
+  EXPECT_EQ(json_value(r.last_line, "align"), "none");
 }
 
 TEST_F(EvaluatorProgram, FrontendChannelWithOutputs) {
@@ -145,19 +141,19 @@ TEST_F(EvaluatorProgram, FrontendChannelWithOutputs) {
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
   EXPECT_NEAR(json_number(r.last_line, "position_rmse_m"), 0.3, 1e-6);
   EXPECT_EQ(json_number(r.last_line, "matched"), 401);
-  EXPECT_EQ(json_value(r.last_line, "estimate_channel"), "\"POSE_FRONTEND\"");
-  EXPECT_EQ(json_value(r.last_line, "reference_channel"), "\"POSE_GROUND_TRUTH\"");
+  EXPECT_EQ(json_value(r.last_line, "estimate_channel"), "POSE_FRONTEND");
+  EXPECT_EQ(json_value(r.last_line, "reference_channel"), "POSE_GROUND_TRUTH");
   EXPECT_EQ(json_number(r.last_line, "non_finite_poses"), 1);
   // The imu_t on the pose2d_t channel: a second type on one channel, counted and dropped.
   EXPECT_EQ(json_number(r.last_line, "mixed_type_messages"), 1);
   EXPECT_EQ(json_number(r.last_line, "decode_failures"), 0);
-  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "\"pose2d_t\"");
+  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "pose2d_t");
   // No backend in this log: no closure, and the closure figures say so.
   EXPECT_EQ(json_number(r.last_line, "loop_closures"), 0);
   EXPECT_EQ(json_number(r.last_line, "false_loop_closures"), 0);
   EXPECT_EQ(json_number(r.last_line, "loop_closures_unmatched"), 0);
-  EXPECT_EQ(json_value(r.last_line, "loop_closure_max_mahalanobis"), "null");
-  EXPECT_EQ(json_value(r.last_line, "loop_closure_rms_error_m"), "null");
+  EXPECT_TRUE(json_value(r.last_line, "loop_closure_max_mahalanobis").is_null());
+  EXPECT_TRUE(json_value(r.last_line, "loop_closure_rms_error_m").is_null());
   EXPECT_TRUE(fs::exists(out / "closures.csv"));
   // The CSV has a header and one row per matched pose.
   std::ifstream csv(out / "errors.csv");
@@ -168,9 +164,8 @@ TEST_F(EvaluatorProgram, FrontendChannelWithOutputs) {
   while (std::getline(csv, row)) ++rows;
   EXPECT_EQ(rows, 401);
   // The plot exists when matplotlib does; the JSON says which.
-  const auto png = json_value(r.last_line, "errors_png");
-  ASSERT_TRUE(png);
-  if (*png != "null") {
+  ASSERT_TRUE(Json::parse(r.last_line).contains("errors_png")) << r.last_line;
+  if (!json_value(r.last_line, "errors_png").is_null()) {
     EXPECT_TRUE(fs::exists(out / "errors.png"));
   }
 }
@@ -178,7 +173,7 @@ TEST_F(EvaluatorProgram, FrontendChannelWithOutputs) {
 TEST_F(EvaluatorProgram, NoMatchIsAFailure) {
   const RunResult r = run("--log " + log_ + " --reference NO_SUCH_CHANNEL");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(json_value(r.last_line, "position_rmse_m"), "null");
+  EXPECT_TRUE(json_value(r.last_line, "position_rmse_m").is_null());
   EXPECT_EQ(json_number(r.last_line, "unmatched"), 401);
 }
 
@@ -226,11 +221,11 @@ TEST_F(EvaluatorProgram, KeyPosesFinalTrajectoryAndLoopClosures) {
   const RunResult r =
       run("--log " + log + " --estimate KEY_POSES --align none --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
-  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "\"key_poses_t\"");
+  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "key_poses_t");
   EXPECT_EQ(json_number(r.last_line, "estimate_poses"), 6);
   EXPECT_EQ(json_number(r.last_line, "key_pose_revisions"), 5);
   // The revisions replaced the first estimates, 0.5 m off.
-  EXPECT_EQ(json_value(r.last_line, "position_max_m"), "0.000000");
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "position_max_m"), 0.0);
   EXPECT_EQ(json_number(r.last_line, "loop_closures"), 3);
   EXPECT_EQ(json_number(r.last_line, "false_loop_closures"), 1);
   EXPECT_EQ(json_number(r.last_line, "loop_closures_unmatched"), 1);
@@ -282,10 +277,10 @@ TEST_F(EvaluatorProgram, DenseSegmentsNewestRevision) {
   const RunResult r = run("--log " + log + " --estimate DENSE_SEGMENTS --align none --config " +
                           any_share_config());
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
-  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "\"dense_segments_t\"");
+  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "dense_segments_t");
   EXPECT_EQ(json_number(r.last_line, "dense_segments"), 3);
   EXPECT_EQ(json_number(r.last_line, "estimate_poses"), 3 * 21 - 2);  // shared ends once
-  EXPECT_EQ(json_value(r.last_line, "position_max_m"), "0.000000");
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "position_max_m"), 0.0);
   EXPECT_EQ(json_number(r.last_line, "loop_closures"), 0);
 }
 
@@ -304,10 +299,10 @@ TEST_F(EvaluatorProgram, MixedTypesOnTheEstimateChannelAreReported) {
   const RunResult r = run("--log " + mixed + " --estimate KEY_POSES --align none --config " +
                           any_share_config() + " 2>/dev/null");
   ASSERT_EQ(r.exit_code, 0) << r.last_line;
-  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "\"key_poses_t\"");
+  EXPECT_EQ(json_value(r.last_line, "estimate_type"), "key_poses_t");
   EXPECT_EQ(json_number(r.last_line, "mixed_type_messages"), 2);
   EXPECT_EQ(json_number(r.last_line, "estimate_poses"), 2);
-  EXPECT_EQ(json_value(r.last_line, "position_max_m"), "0.000000");
+  EXPECT_DOUBLE_EQ(json_number(r.last_line, "position_max_m"), 0.0);
 }
 
 // The issue's "perfect run": a log of 237 scans whose stamps carried no time, a backend that
@@ -332,9 +327,9 @@ TEST(EvaluatorProgramCoverage, ASinglePoseIsAFailureNotAPerfectRun) {
   EXPECT_EQ(json_number(r.last_line, "matched"), 1);
   EXPECT_EQ(json_number(r.last_line, "reference_covered"), 1);
   EXPECT_NEAR(json_number(r.last_line, "reference_share"), 1.0 / 237, 1e-4);
-  EXPECT_EQ(json_value(r.last_line, "refused"), "true");
-  EXPECT_EQ(json_value(r.last_line, "position_rmse_m"), "null");
-  EXPECT_EQ(json_value(r.last_line, "max_jump_m"), "null");
+  EXPECT_EQ(json_value(r.last_line, "refused"), true);
+  EXPECT_TRUE(json_value(r.last_line, "position_rmse_m").is_null());
+  EXPECT_TRUE(json_value(r.last_line, "max_jump_m").is_null());
   fs::remove_all(dir);
 }
 
@@ -342,7 +337,7 @@ TEST_F(EvaluatorProgram, PartialCoverageIsRefusedFullIsNot) {
   // The frontend's poses cover all 10 s of truth: scored.
   const RunResult full = run("--log " + log_);
   EXPECT_EQ(full.exit_code, 0) << full.last_line;
-  EXPECT_EQ(json_value(full.last_line, "refused"), "false");
+  EXPECT_EQ(json_value(full.last_line, "refused"), false);
   EXPECT_NEAR(json_number(full.last_line, "reference_share"), 1.0, 1e-3);
   EXPECT_EQ(json_number(full.last_line, "min_reference_share"), 0.8);
   // A stage that stopped after 7 s: 70 % of the truth, refused by default, scored at 0.6.
@@ -361,13 +356,13 @@ TEST_F(EvaluatorProgram, PartialCoverageIsRefusedFullIsNot) {
   }
   const RunResult refused = run("--log " + partial + " 2>/dev/null");
   EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_EQ(json_value(refused.last_line, "refused"), "true");
+  EXPECT_EQ(json_value(refused.last_line, "refused"), true);
   EXPECT_NEAR(json_number(refused.last_line, "reference_share"), 0.68, 0.01);
   const fs::path cfg = dir_ / "share.yaml";
   std::ofstream(cfg) << "min_reference_share: 0.6\n";
   const RunResult lenient = run("--log " + partial + " --config " + cfg.string());
   EXPECT_EQ(lenient.exit_code, 0) << lenient.last_line;
-  EXPECT_EQ(json_value(lenient.last_line, "position_max_m"), "0.000000");
+  EXPECT_DOUBLE_EQ(json_number(lenient.last_line, "position_max_m"), 0.0);
 }
 
 // --relations on a log: relations between scans 1 s apart, each 2 cm longer in x than the truth
@@ -390,7 +385,7 @@ TEST_F(EvaluatorProgram, RelationsModeScoresTheEstimateChannel) {
   const RunResult truth = run("--log " + log_ + " --estimate POSE_GROUND_TRUTH --relations " +
                               rel.string() + " --out " + (dir_ / "out").string());
   ASSERT_EQ(truth.exit_code, 0) << truth.last_line;
-  EXPECT_EQ(json_value(truth.last_line, "mode"), "\"relations\"");
+  EXPECT_EQ(json_value(truth.last_line, "mode"), "relations");
   EXPECT_EQ(json_number(truth.last_line, "relations"), 74);
   EXPECT_EQ(json_number(truth.last_line, "relations_used"), 73);
   EXPECT_EQ(json_number(truth.last_line, "relations_missing"), 1);
@@ -399,7 +394,7 @@ TEST_F(EvaluatorProgram, RelationsModeScoresTheEstimateChannel) {
   EXPECT_NEAR(json_number(truth.last_line, "trans_sd_m"), 0.0, 2e-6);
   EXPECT_NEAR(json_number(truth.last_line, "trans_sq_mean_m2"), 4e-4, 1e-7);
   EXPECT_NEAR(json_number(truth.last_line, "rot_mean_deg"), 0.0, 1e-6);
-  EXPECT_EQ(json_value(truth.last_line, "estimate_channel"), "\"POSE_GROUND_TRUTH\"");
+  EXPECT_EQ(json_value(truth.last_line, "estimate_channel"), "POSE_GROUND_TRUTH");
   std::ifstream csv(dir_ / "out" / "relations.csv");
   int rows = -1;
   for (std::string line; std::getline(csv, line);) ++rows;
@@ -414,8 +409,8 @@ TEST_F(EvaluatorProgram, RelationsModeScoresTheEstimateChannel) {
   const RunResult none =
       run("--log " + log_ + " --estimate POSE_DENSE --relations " + rel.string() + " 2>/dev/null");
   EXPECT_EQ(none.exit_code, 1);
-  EXPECT_EQ(json_value(none.last_line, "refused"), "true");
-  EXPECT_EQ(json_value(none.last_line, "trans_mean_m"), "null");
+  EXPECT_EQ(json_value(none.last_line, "refused"), true);
+  EXPECT_TRUE(json_value(none.last_line, "trans_mean_m").is_null());
 }
 
 TEST(EvaluatorProgramArgs, BadAlignIsAConfigError) {

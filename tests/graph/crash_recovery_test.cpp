@@ -4,9 +4,7 @@
 // missing, and the final key poses' and dense trajectory's RMSE against ground truth within 2 mm
 // of the undisturbed run's. The run log stays whole.
 #include <gtest/gtest.h>
-#include <signal.h>
 
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <thread>
@@ -30,17 +28,6 @@ int32_t key_pose_count(const std::string& log) {
     }
   }
   return total;
-}
-
-// Position RMSE [m] of a run's final trajectory on `channel` against ground truth.
-double rmse(const std::filesystem::path& run_dir, const std::string& channel) {
-  const auto r = run(bin_dir() + "/traverse-evaluator --config configs/evaluator.yaml --log " +
-                         (run_dir / "run.lcmlog").string() + " --estimate " + channel +
-                         " --reference POSE_GROUND_TRUTH --out " + run_dir.string() +
-                         " | tail -1 | python3 scripts/conf.py get - position_rmse_m",
-                     60);
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  return r.exit_code == 0 ? std::stod(r.output) : -1.0;
 }
 
 TEST(CrashRecovery, BackendKilledMidRunIsRestartedAndResumesItsGraph) {
@@ -70,21 +57,11 @@ TEST(CrashRecovery, BackendKilledMidRunIsRestartedAndResumesItsGraph) {
   const auto undisturbed = launch((dir / "undisturbed").string());
   ASSERT_EQ(undisturbed.exit_code, 0) << undisturbed.output;
 
-  std::thread killer([&] {
-    const auto status = dir / "killed-run" / "processes.json";
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (std::chrono::steady_clock::now() < deadline && !running_pid(status, "logplayer")) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
-    std::this_thread::sleep_for(std::chrono::seconds(7));
-    const int pid = running_pid(status, "backend");
-    if (pid > 0) kill(pid, SIGKILL);
-    std::ofstream(dir / "killed") << pid;
-  });
+  int killed = 0;
+  std::thread killer(
+      [&] { killed = kill_into_replay(dir / "killed-run" / "processes.json", "backend", 7.0); });
   const auto killed_run = launch((dir / "killed-run").string());
   killer.join();
-  int killed = 0;
-  std::ifstream(dir / "killed") >> killed;
   ASSERT_GT(killed, 0) << killed_run.output;
   EXPECT_EQ(killed_run.exit_code, 0) << killed_run.output;
   EXPECT_NE(killed_run.output.find("backend died (killed by SIGKILL (died)); restart 1 of 2"),
@@ -103,10 +80,10 @@ TEST(CrashRecovery, BackendKilledMidRunIsRestartedAndResumesItsGraph) {
   // gap fall on other scans (their interval starts again from the resumed last key pose), so the
   // runs are compared through the ground truth.
   EXPECT_GE(keys_b + 8, keys_a);
-  const double keys_rmse_a = rmse(dir / "undisturbed", "KEY_POSES");
-  const double keys_rmse_b = rmse(dir / "killed-run", "KEY_POSES");
-  const double dense_a = rmse(dir / "undisturbed", "DENSE_SEGMENTS");
-  const double dense_b = rmse(dir / "killed-run", "DENSE_SEGMENTS");
+  const double keys_rmse_a = position_rmse(dir / "undisturbed", "KEY_POSES");
+  const double keys_rmse_b = position_rmse(dir / "killed-run", "KEY_POSES");
+  const double dense_a = position_rmse(dir / "undisturbed", "DENSE_SEGMENTS");
+  const double dense_b = position_rmse(dir / "killed-run", "DENSE_SEGMENTS");
   EXPECT_LT(std::abs(keys_rmse_a - keys_rmse_b), 0.002) << keys_rmse_a << " " << keys_rmse_b;
   EXPECT_LT(std::abs(dense_a - dense_b), 0.002) << dense_a << " " << dense_b;
   std::printf(

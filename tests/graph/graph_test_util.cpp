@@ -1,14 +1,18 @@
 #include "graph_test_util.hpp"
 
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 #include "lcm_log.hpp"
 #include "traverse/process_status_t.hpp"
@@ -96,6 +100,59 @@ std::string short_intel_log(const std::filesystem::path& dir, int lines) {
           60);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   return lcm_log;
+}
+
+double position_rmse(const std::filesystem::path& run_dir, const std::string& channel) {
+  const auto r = run(bin_dir() + "/traverse-evaluator --config configs/evaluator.yaml --log " +
+                         (run_dir / "run.lcmlog").string() + " --estimate " + channel +
+                         " --reference POSE_GROUND_TRUTH --out " + run_dir.string() +
+                         " | tail -1 | python3 scripts/conf.py get - position_rmse_m",
+                     60);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return r.exit_code == 0 ? std::stod(r.output) : -1.0;
+}
+
+int kill_into_replay(const std::filesystem::path& processes_json, const std::string& victim,
+                     double delay_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline && !running_pid(processes_json, "logplayer")) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+  const int pid = running_pid(processes_json, victim);
+  if (pid > 0) kill(pid, SIGKILL);
+  return pid;
+}
+
+int64_t cloud_points(const std::filesystem::path& ply) {
+  std::ifstream in(ply);
+  std::string line;
+  while (std::getline(in, line) && line != "end_header") {
+    if (line.rfind("element vertex ", 0) == 0) return std::stoll(line.substr(15));
+  }
+  return -1;
+}
+
+std::set<std::tuple<int, int, int>> occupied_voxels(const std::filesystem::path& bt) {
+  std::set<std::tuple<int, int, int>> out;
+  octomap::OcTree tree(0.1);  // the file's resolution replaces this
+  if (!tree.readBinary(bt.string())) return out;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    if (tree.isNodeOccupied(*it)) out.emplace(it.getKey()[0], it.getKey()[1], it.getKey()[2]);
+  }
+  return out;
+}
+
+std::vector<pose2d_t> poses_on(const std::string& lcm_log, const std::string& channel) {
+  std::vector<pose2d_t> out;
+  LogReader reader(lcm_log);
+  while (auto ev = reader.next()) {
+    pose2d_t p;
+    if (ev->channel == channel &&
+        p.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) > 0)
+      out.push_back(p);
+  }
+  return out;
 }
 
 }  // namespace traverse::graph_test

@@ -4,8 +4,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
+
+#include "traverse/pose2d_t.hpp"
 
 namespace traverse::graph_test {
 
@@ -37,6 +41,21 @@ struct StatusMessage {
   std::map<std::string, int64_t> missed;  // [messages] per channel, sequence numbers skipped
 };
 std::vector<StatusMessage> statuses(const std::string& lcm_log);
+
+// Position RMSE [m] of a run's final trajectory on `channel` (run_dir/run.lcmlog) against the
+// ground truth, by traverse-evaluator; -1 (and a test failure) when it fails.
+double position_rmse(const std::filesystem::path& run_dir, const std::string& channel);
+// Waits until a launcher's processes.json shows its log player running (at most 60 s), then
+// `delay_s` more, and SIGKILLs process `victim`; its pid, 0 when it was not running.
+int kill_into_replay(const std::filesystem::path& processes_json, const std::string& victim,
+                     double delay_s);
+
+// The number of points of a PLY cloud (its header), -1 when it cannot be read.
+int64_t cloud_points(const std::filesystem::path& ply);
+// The occupied voxels of an OctoMap file (.bt), as keys; none when it cannot be read.
+std::set<std::tuple<int, int, int>> occupied_voxels(const std::filesystem::path& bt);
+// The pose2d_t messages of `channel` in an LCM log.
+std::vector<pose2d_t> poses_on(const std::string& lcm_log, const std::string& channel);
 
 // A short LCM log made by traverse-carmen from the first `lines` lines of the Intel CARMEN log.
 std::string short_intel_log(const std::filesystem::path& dir, int lines);

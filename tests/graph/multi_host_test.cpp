@@ -15,6 +15,7 @@
 
 #include "deployment.hpp"
 #include "graph_test_util.hpp"
+#include "json.hpp"
 #include "lcm_log.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -132,8 +133,11 @@ Products products(const std::filesystem::path& out) {
   }
   std::ifstream log(out / "evaluator.log");
   for (std::string line; std::getline(log, line);) {
-    const auto at = line.find("\"position_rmse_m\": ");
-    if (at != std::string::npos) p.dense_rmse_m = std::stod(line.substr(at + 19));
+    if (line.empty() || line.front() != '{') continue;  // the evaluator's JSON line
+    const Json j = Json::parse(line, nullptr, false);
+    if (!j.is_discarded() && j.contains("position_rmse_m") && j["position_rmse_m"].is_number()) {
+      p.dense_rmse_m = j["position_rmse_m"].get<double>();
+    }
   }
   std::ifstream ply(out / "mapper" / "cloud.ply");
   for (std::string line; std::getline(ply, line) && line != "end_header";) {
@@ -232,9 +236,9 @@ TEST(MultiHost, OneLauncherPerHostEachStartsItsOwnProcesses) {
       bin + "--host server --out " + (dir / "server").string() + " > " +
           (dir / "server.out").string() + " 2>&1 & server=$!; sleep 1; " + bin +
           "--host cart --log " + kLog + " --out " + (dir / "cart").string() +
-          " --grace 4 & cart=$!; sleep 2; until grep -q " + "\"logplayer[^}]*running.:false\" " +
-          cart_status +
-          " || ! kill -0 $cart; do sleep 0.2; done; kill -INT $server; wait $server; server=$?; " +
+          " --grace 4 & cart=$!; sleep 2; until [ \"$(python3 scripts/conf.py get " + cart_status +
+          " processes.logplayer.running 2>/dev/null)\" = false ] || ! kill -0 $cart; do sleep 0.2;"
+          " done; kill -INT $server; wait $server; server=$?; " +
           "wait $cart; echo cart=$? server=$server; cat " + (dir / "server.out").string(),
       120);
   EXPECT_NE(r.output.find("cart=0 server=130"), std::string::npos) << r.output;

@@ -1,12 +1,14 @@
 // Sessions (docs/deployment.md): a mapping session stopped after 10 s and resumed later
-// (run-graph.sh --resume) on the next 10 s goes on in the same map frame, the backend with the
-// same graph; resumed at another site, the frontend stops with a clear error (exit 4) instead of
-// mapping into the old map at a wrong place.
+// (run-graph.sh --resume) on the next 6 s goes on in the same map frame, the backend with the
+// same graph, the mapper with the same cloud and OctoMap; resumed at another site, the frontend
+// stops with a clear error (exit 4) instead of mapping into the old map at a wrong place.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <set>
+#include <tuple>
 
 #include "graph_test_util.hpp"
 #include "lcm_log.hpp"
@@ -28,18 +30,6 @@ void cut(const std::string& in, const std::string& out, int64_t from_us, int64_t
     lcm::LogEvent copy = *ev;
     writer.writeEvent(&copy);
   }
-}
-
-std::vector<pose2d_t> poses_on(const std::string& log, const std::string& channel) {
-  std::vector<pose2d_t> out;
-  LogReader reader(log);
-  while (auto ev = reader.next()) {
-    pose2d_t p;
-    if (ev->channel == channel &&
-        p.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) > 0)
-      out.push_back(p);
-  }
-  return out;
 }
 
 // The largest position error [m] of `est` against the truth turned into the frame in which the
@@ -67,8 +57,8 @@ TEST(Session, StoppedAndResumedLaterGoesOnInTheSameMap) {
   const std::string sim = (dir / "sim.lcmlog").string();
   ASSERT_EQ(run(bin_dir() +
                     "/traverse-sim --config configs/sim.yaml --world configs/worlds/office.yaml "
-                    "--route configs/routes/office-s2.yaml --profile ideal --seed 1 --duration 40 "
-                    "--profile-every 1000000000 --out " +
+                    "--route configs/routes/office-s2.yaml --profile ideal --seed 1 --duration 16 "
+                    "--profile-every 5 --out " +
                     sim,
                 120)
                 .exit_code,
@@ -89,11 +79,16 @@ TEST(Session, StoppedAndResumedLaterGoesOnInTheSameMap) {
             0);
   cut(court, far, 11'000'000, 14'000'000);
   const std::string deploy = (dir / "deploy.yaml").string();
-  std::ofstream(deploy) << "processes:\n"
-                           "  - {name: frontend, program: traverse-frontend, config: "
-                           "configs/frontend.yaml, args: [--state-dir, \"{out}/state/frontend\"]}\n"
-                           "  - {name: backend, program: traverse-backend, config: "
-                           "configs/backend.yaml, args: [--state-dir, \"{out}/state/backend\"]}\n";
+  std::ofstream(deploy)
+      << "processes:\n"
+         "  - {name: frontend, program: traverse-frontend, config: "
+         "configs/frontend.yaml, args: [--state-dir, \"{out}/state/frontend\"]}\n"
+         "  - {name: backend, program: traverse-backend, config: "
+         "configs/backend.yaml, args: [--state-dir, \"{out}/state/backend\"]}\n"
+         "  - {name: densifier, program: traverse-densifier, config: "
+         "configs/densifier.yaml}\n"
+         "  - {name: mapper, program: traverse-mapper, config: configs/mapper.yaml, "
+         "args: [--out, \"{out}/mapper\", --state-dir, \"{out}/state/mapper\"]}\n";
   const auto session = [&](const std::string& log, const std::string& out,
                            const std::string& resume) {
     return run("TRAVERSE_BIN_DIR=" + bin_dir() + " scripts/run-graph.sh --deploy " + deploy +
@@ -140,6 +135,26 @@ TEST(Session, StoppedAndResumedLaterGoesOnInTheSameMap) {
   }
   EXPECT_GT(total1, 20);
   EXPECT_GT(total2, total1 + 10);
+
+  // The mapper goes on with session 1's cloud and OctoMap: session 2's exports hold session 1's
+  // points and voxels (all of them: session 2 moves none of session 1's trajectory here) and its
+  // own.
+  EXPECT_NE(read_text(dir / "s2/mapper.log").find("resumed from"), std::string::npos);
+  const int64_t points1 = cloud_points(dir / "s1/mapper/cloud.ply"),
+                points2 = cloud_points(dir / "s2/mapper/cloud.ply");
+  const auto voxels1 = occupied_voxels(dir / "s1/mapper/map.bt"),
+             voxels2 = occupied_voxels(dir / "s2/mapper/map.bt");
+  std::size_t kept = 0;
+  for (const auto& k : voxels1) kept += voxels2.count(k);
+  std::printf(
+      "session: cloud points %lld after session 1, %lld after session 2; %zu of session "
+      "1's %zu occupied voxels in session 2's %zu\n",
+      static_cast<long long>(points1), static_cast<long long>(points2), kept, voxels1.size(),
+      voxels2.size());
+  EXPECT_GT(points1, 50000);
+  EXPECT_GT(points2, points1 + points1 / 4);  // 6 s more of profiles after 10 s
+  EXPECT_EQ(kept, voxels1.size());
+  EXPECT_GT(voxels2.size(), voxels1.size());
 
   // Resumed at another site: refused, said, nothing published.
   const auto s3 = session(far, "s3", "s1");

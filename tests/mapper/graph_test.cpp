@@ -15,6 +15,7 @@
 #include "densifier_node.hpp"
 #include "mapper_node.hpp"
 #include "ply.hpp"
+#include "test_profile.hpp"
 
 namespace traverse {
 namespace {
@@ -70,16 +71,7 @@ class GraphTest : public ::testing::TestWithParam<bool> {
     bus_.publish(channels::kKeyPoses, msg);
   }
   void send_profile(int64_t t0) {
-    planar_scan_t s{};
-    s.utime = s.utime_first = t0;
-    s.utime_last = t0 + 30'000;
-    s.frame = "laser_profile";
-    s.angle_first = static_cast<float>(-std::numbers::pi);
-    s.angle_step = static_cast<float>(2 * std::numbers::pi / 360);
-    s.range_min = 0.6f;
-    s.range_max = 6.0f;
-    s.ranges.assign(360, 2.0f);
-    s.n_ranges = 360;
+    planar_scan_t s = test_profile(t0, std::vector<float>(360, 2.0f));
     bus_.publish(channels::kScanProfile, s);
   }
 

@@ -4,12 +4,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 
 #include "../backend/test_graphs.hpp"
 #include "graph_io.hpp"
+#include "json.hpp"
 
 namespace traverse::backend {
 namespace {
@@ -39,11 +39,10 @@ std::string last_line(const std::string& s) {
   return t.substr(t.rfind('\n') == std::string::npos ? 0 : t.rfind('\n') + 1);
 }
 
-// The value of a numeric or boolean key in a flat JSON line.
+// The value of a key of the JSON summary line as JSON text ("" when absent).
 std::string json_value(const std::string& json, const std::string& key) {
-  std::smatch m;
-  const std::regex re("\"" + key + "\": ([^,}]+)");
-  return std::regex_search(json, m, re) ? m[1].str() : "";
+  const traverse::Json j = traverse::Json::parse(json, nullptr, false);
+  return !j.is_discarded() && j.is_object() && j.contains(key) ? j[key].dump() : "";
 }
 
 class PgoProgram : public ::testing::Test {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "bus.hpp"
+#include "json.hpp"
 #include "run_program.hpp"
 #include "test_messages.hpp"
 #include "traverse/process_status_t.hpp"
@@ -94,12 +95,11 @@ TEST(MonitorProgram, WritesWhatItHeardAtShutdown) {
   EXPECT_TRUE(WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
 
   const std::string json = read_file(out);
-  EXPECT_NE(json.find(R"("POSE_MONITOR_TEST":{"type":"traverse.pose2d_t","count":5,)"),
-            std::string::npos)
-      << json;
-  EXPECT_NE(json.find(R"("monitor_test":{"channel":"STATUS_MONITOR_TEST","state":"running")"),
-            std::string::npos)
-      << json;
+  const Json j = Json::parse(json);
+  EXPECT_EQ(j["channels"]["POSE_MONITOR_TEST"]["type"], "traverse.pose2d_t") << json;
+  EXPECT_EQ(j["channels"]["POSE_MONITOR_TEST"]["count"], 5) << json;
+  EXPECT_EQ(j["processes"]["monitor_test"]["channel"], "STATUS_MONITOR_TEST") << json;
+  EXPECT_EQ(j["processes"]["monitor_test"]["state"], "running") << json;
   // The same JSON is the last line of its standard output.
   EXPECT_NE(read_file(stdout_path).find(json), std::string::npos);
   fs::remove(out);
