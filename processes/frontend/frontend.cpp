@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calibration/calibrated_frontend.hpp"
 #include "hector/hector_frontend.hpp"
 #include "icp/icp_frontend.hpp"
 #include "sparse/ensemble.hpp"
@@ -11,8 +12,9 @@
 
 namespace traverse::frontend {
 
-std::unique_ptr<Frontend> make_frontend(const FrontendConfig& config) {
-  if (config.kind == "icp") return std::make_unique<IcpFrontend>(config);
+namespace {
+
+std::unique_ptr<Frontend> make_hector(const FrontendConfig& config) {
   // One Hector frontend starting at T_map_base_initial, one scan behind on a log subsampled by
   // travel when the config says so.
   const auto make_member = [config](const Pose2& T_map_base_initial) -> std::unique_ptr<Frontend> {
@@ -30,6 +32,15 @@ std::unique_ptr<Frontend> make_frontend(const FrontendConfig& config) {
   // The members' grids are offset by fractions of a cell of the wide search's level.
   const double cell_m = config.map.resolution_m * std::pow(2.0, std::min(1, config.map.levels - 1));
   return std::make_unique<SparseEnsemble>(make_member, T_map_base_initial, members, cell_m);
+}
+
+}  // namespace
+
+std::unique_ptr<Frontend> make_frontend(const FrontendConfig& config) {
+  if (config.kind == "icp") return std::make_unique<IcpFrontend>(config);
+  auto frontend = make_hector(config);
+  if (!config.calibration.extrinsic_yaw) return frontend;
+  return std::make_unique<CalibratedFrontend>(std::move(frontend), config);
 }
 
 }  // namespace traverse::frontend

@@ -51,6 +51,10 @@ struct FrontendDiagnostics {
   int iterations = 0;
   double residual_rms = 0.0;  // [unitless] RMS of 1 - M at the result (Hector)
   bool searched = false;      // the matcher needed a correlative search
+  // Smallest over largest eigenvalue of the scan's information (Hector: hector/degeneracy.hpp),
+  // 0 to 1, and how many directions were held at the prediction.
+  double degeneracy_ratio = 1.0;
+  int degenerate_directions = 0;
   // Sparse-scan ensemble: members whose step agrees with the published one, of how many voted.
   int ensemble_agreeing = 0, ensemble_voting = 0;
 };

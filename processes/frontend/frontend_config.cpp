@@ -61,6 +61,8 @@ std::optional<std::string> validate(const MatcherConfig& c) {
                 "sparse_lag_window_rad", "must be in (0, pi]");
   check.not_negative("sparse_lag_long_weight", c.sparse_lag_long_weight);
   check.not_negative("sparse_lag_margin", c.sparse_lag_margin);
+  check.in_range("degeneracy_min_ratio", c.degeneracy_min_ratio, 0.0, 1.0);
+  check.in_range("moved_max_probability", c.moved_max_probability, 0.0, 0.5);
   return check.problem();
 }
 
@@ -91,6 +93,16 @@ std::optional<std::string> validate(const MotionPriorConfig& c) {
   check.in_range("odometry_check_sigmas", c.odometry_check_sigmas, 0.0, 100.0);
   check.in_range("search_min_linear_m", c.search_min_linear_m, 0.0, 100.0);
   check.in_range("search_min_angular_rad", c.search_min_angular_rad, 0.0, M_PI);
+  check.in_range("prediction_sigma_mps", c.prediction_sigma_mps, 0.0, 100.0);
+  check.in_range("prediction_sigma_radps", c.prediction_sigma_radps, 0.0, 100.0);
+  return check.problem();
+}
+
+std::optional<std::string> validate(const CalibrationConfig& c) {
+  ConfigCheck check;
+  check.in_range("chord_m", c.chord_m, 0.05, 100.0);
+  check.in_range("min_travel_m", c.min_travel_m, 0.0, 1e6);
+  check.in_range("max_yaw_rad", c.max_yaw_rad, 0.0, 0.5);
   return check.problem();
 }
 
@@ -110,6 +122,7 @@ std::optional<std::string> validate(const FrontendConfig& c) {
   check.nested("motion_prior", validate(c.motion_prior));
   check.nested("icp", validate(c.icp));
   check.nested("handover", validate(c.handover));
+  check.nested("calibration", validate(c.calibration));
   if (check.problem()) return check.problem();
   // The searches' windows in cells of the level each runs on: the recovery search on the
   // coarsest, the wide search on level 1 (or 0 with one level).

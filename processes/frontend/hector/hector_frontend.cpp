@@ -1,11 +1,14 @@
 #include "hector_frontend.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "degeneracy.hpp"
 #include "deskew.hpp"
 #include "grid_search.hpp"
+#include "moved_points.hpp"
 #include "scan_matcher.hpp"
 #include "sweep_input.hpp"
 
@@ -104,6 +107,7 @@ Measurement HectorFrontend::measure(const Scan& scan) {
         motion_.predict(scan.utime_last, use_imu, r.sparse,
                         !m.subsampled_by_travel || config_.motion_prior.subsampled_logs);
     deskew();
+    if (!r.sparse) drop_moved(points.points_base, with.T_map_base);
     m.points_matched = subsample(points.points_base, config_.matcher.min_point_spacing_m);
     Attempt attempt = match_from(m, with);
     // Odometry's step is checked against the scan (a scanner's stream): matched also from the
@@ -140,6 +144,9 @@ Measurement HectorFrontend::measure(const Scan& scan) {
       return m;
     }
     take_match(r, match);
+    // Directions the scan does not determine keep the prediction (degeneracy.hpp). Sparse scans
+    // are predicted too poorly for it: their wide search's spread already says what is open.
+    if (!r.sparse) hold_degenerate(r, match, attempt.prediction);
   }
   ++counters_.scans_matched;
   m.points = std::move(points.points_base);
@@ -167,6 +174,39 @@ HectorFrontend::Attempt HectorFrontend::match_from(const Measurement& m,
                    : match_scan(map_, m.points_matched, T_pred, matcher, -1, 0, other_centres);
   a.unverified = !sparse && unverified(a.match, T_pred, config_.matcher);
   return a;
+}
+
+void HectorFrontend::drop_moved(std::vector<Eigen::Vector2d>& points_base,
+                                const Pose2& T_map_base_predicted) {
+  const double p_max = config_.matcher.moved_max_probability;
+  if (p_max <= 0.0) return;
+  const std::vector<bool> moved = seen_through(map_.level(std::min(1, map_.levels() - 1)),
+                                               points_base, T_map_base_predicted, p_max);
+  const auto n = static_cast<std::size_t>(std::count(moved.begin(), moved.end(), true));
+  // Most of a scan in free space says the prediction is off, not that the world moved.
+  if (n == 0 || 2 * n > points_base.size()) return;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < points_base.size(); ++i) {
+    if (!moved[i]) points_base[kept++] = points_base[i];
+  }
+  points_base.resize(kept);
+  counters_.points_moved += static_cast<int64_t>(n);
+}
+
+void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match,
+                                     const MotionModel::Prediction& prediction) {
+  const Degeneracy dg = analyse_degeneracy(match.information, match.points_rms_range_m,
+                                           std::max(config_.matcher.degeneracy_min_ratio, 1e-12));
+  r.diagnostics->degeneracy_ratio = dg.ratio;
+  if (config_.matcher.degeneracy_min_ratio <= 0.0 || dg.directions == 0) return;
+  ++counters_.scans_degenerate;
+  r.diagnostics->degenerate_directions = dg.directions;
+  // Only odometry measures the motion along such a direction; the velocity of the last poses
+  // would carry on whatever speed the corridor was entered with, and the match's faint hold
+  // (an end wall 40 m ahead, a door recess) does better than that. Either way the covariance
+  // says how little the scan fixed there.
+  if (prediction.odometry) r.T_map_base = remap(dg, prediction.T_map_base, r.T_map_base);
+  r.covariance = remapped_covariance(dg, prediction.covariance);
 }
 
 bool HectorFrontend::differ(const Pose2& a, const Pose2& b) const {
@@ -299,8 +339,10 @@ void HectorFrontend::report(const CounterSink& sink) const {
   sink("scans_predicted", static_cast<double>(c.scans_predicted));
   sink("scans_unverified", static_cast<double>(c.scans_unverified));
   sink("scans_searched", static_cast<double>(c.scans_searched));
+  sink("scans_degenerate", static_cast<double>(c.scans_degenerate));
   sink("scans_dropped_time", static_cast<double>(c.scans_dropped_time));
   sink("readings_invalid", static_cast<double>(c.readings_invalid));
+  sink("points_moved", static_cast<double>(c.points_moved));
   sink("map_updates", static_cast<double>(c.map_updates));
   sink("map_tiles_evicted", static_cast<double>(c.map_tiles_evicted));
   sink("imu_samples", static_cast<double>(c.imu_samples));

@@ -6,14 +6,17 @@
 //      prior combines them (../motion_prior.hpp), the velocity of the last poses, or the average
 //      step of a sparse log); with odometry, the searches below are centred on the prediction and
 //      sized by the odometry step's covariance, and the recovery search leaves the last pose out;
-//   3. undo the motion during the sweep (deskew.hpp);
+//   3. undo the motion during the sweep (deskew.hpp), and on a scanner's stream leave out the
+//      points that lie where the map has seen through (moved_points.hpp: people, mixed pixels);
 //   4. match the points against the map pyramid, coarse to fine, from the prediction
 //      (scan_matcher.hpp); sparse scans, those more than matcher.wide_search_gap_us after the
 //      last pose or of a stream whose recent scans were (a log subsampled by travel), from the
 //      best pose of a wide correlative search around it (grid_search.hpp), which on a log
 //      subsampled by travel also weighs the step's shape (step_prior.hpp);
 //   5. a match on a scanner's stream that lands far from the prediction with a poor fit is not
-//      trusted: the pose is the prediction, flagged, and the scan stays out of the map.
+//      trusted: the pose is the prediction, flagged, and the scan stays out of the map;
+//   6. directions of the pose the scan does not determine (a bare corridor's axis) keep the
+//      prediction, and its covariance (degeneracy.hpp).
 // Integrating it: the pose goes into the motion model, and the scan into the map when the pose
 // moved or turned past a threshold since the last update. A scan whose time does not advance, or
 // whose last point is before its first, is dropped. Each case is counted.
@@ -59,8 +62,10 @@ class HectorFrontend final : public TwoPhaseFrontend {
     int64_t scans_predicted = 0;     // too few valid points
     int64_t scans_unverified = 0;    // match far from the prediction with a poor fit: predicted
     int64_t scans_searched = 0;      // matches that needed a correlative search
+    int64_t scans_degenerate = 0;    // matches with a direction held at the prediction
     int64_t scans_dropped_time = 0;  // time going backwards or utime_last < utime_first
     int64_t readings_invalid = 0;    // NaN, zero or out-of-range readings ignored
+    int64_t points_moved = 0;        // points where the map saw through (moved_points.hpp)
     int64_t map_updates = 0;
     int64_t map_tiles_evicted = 0;
     int64_t imu_samples = 0;
@@ -94,6 +99,13 @@ class HectorFrontend final : public TwoPhaseFrontend {
     bool unverified = false;
   };
   Attempt match_from(const Measurement& m, const MotionModel::Prediction& prediction) const;
+  // Drops the points the map has seen through at the predicted pose (moved_points.hpp,
+  // MatcherConfig::moved_max_probability), unless that is most of them.
+  void drop_moved(std::vector<Eigen::Vector2d>& points_base, const Pose2& T_map_base_predicted);
+  // The result's pose and covariance with the directions the scan does not determine held at
+  // the prediction (degeneracy.hpp, MatcherConfig::degeneracy_min_ratio).
+  void hold_degenerate(FrontendResult& r, const MatchResult& match,
+                       const MotionModel::Prediction& prediction);
   // a and b lie more than a map cell or 0.01 rad apart (worth matching from both).
   bool differ(const Pose2& a, const Pose2& b) const;
   // a fits better than b: verified where b is not, else a residual lower by more than margin.

@@ -1,6 +1,7 @@
 #include "motion_model.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace traverse::frontend {
 namespace {
@@ -76,8 +77,17 @@ MotionModel::Prediction MotionModel::predict(int64_t utime, bool use_imu, bool s
     const Pose2& step = p.odometry->T_base0_base1;
     const double turn = use_imu ? yaw_.heading_change(s.last_utime, utime) : step.theta();
     p.T_map_base = s.T_map_base_last * Pose2(step.x(), step.y(), turn);
+    p.covariance =
+        s.covariance_last + rotate_covariance(p.odometry->covariance, s.T_map_base_last.rotation());
     return p;
   }
+  const double dt = 1e-6 * static_cast<double>(std::max<int64_t>(0, utime - s.last_utime));
+  const MotionPriorConfig& c = prior_.config();
+  p.covariance = s.covariance_last + Eigen::Vector3d(std::pow(c.prediction_sigma_mps * dt, 2),
+                                                     std::pow(c.prediction_sigma_mps * dt, 2),
+                                                     std::pow(c.prediction_sigma_radps * dt, 2))
+                                         .asDiagonal()
+                                         .toDenseMatrix();
   if (sparse && s.sparse_step && !use_imu) {
     p.T_map_base = s.T_map_base_last * Pose2::exp(*s.sparse_step);
     return p;

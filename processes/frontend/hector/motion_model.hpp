@@ -77,6 +77,10 @@ class MotionModel {
     Pose2 T_map_base;
     std::optional<OdometryStep> odometry;  // the odometry step it used, with its covariance
     OdometryMiss odometry_miss = OdometryMiss::kNone;  // why not, where the source names it
+    // Of T_map_base (x [m], y [m], theta [rad], map frame): the last pose's, grown by the
+    // odometry step's, or without odometry by MotionPriorConfig::prediction_sigma_* times the
+    // time predicted.
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   };
   // with_odometry false: as if no odometry had come (the prediction odometry would overrule).
   Prediction predict(int64_t utime, bool use_imu, bool sparse, bool with_odometry = true) const;

@@ -5,22 +5,31 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "grid_search.hpp"
 #include "step_prior.hpp"
+#include "surface_normals.hpp"
 
 namespace traverse::frontend {
 
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
-                                 const Pose2& T_map_base) {
+                                 const Pose2& T_map_base,
+                                 const std::vector<Eigen::Vector2d>* normals_base) {
   NormalEquations ne;
   const Eigen::Matrix2d R = T_map_base.rotation();
   const double c = R(0, 0), s = R(1, 0);
   Eigen::Vector2d grad;
-  for (const auto& p : points_base) {
+  for (std::size_t i = 0; i < points_base.size(); ++i) {
+    const Eigen::Vector2d& p = points_base[i];
     const Eigen::Vector2d q = R * p + T_map_base.translation();  // S_i(xi), eq. 7
     const double r = 1.0 - grid.value(q, &grad);
+    if (normals_base && !(*normals_base)[i].isZero()) {
+      // Only the gradient across the point's surface (surface_normals.hpp).
+      const Eigen::Vector2d n = R * (*normals_base)[i];
+      grad = grad.dot(n) * n;
+    }
     // dS_i/dpsi (eq. 13) contracted with the map gradient.
     const double dpsi = grad.x() * (-s * p.x() - c * p.y()) + grad.y() * (c * p.x() - s * p.y());
     const Eigen::Vector3d J(grad.x(), grad.y(), dpsi);
@@ -53,10 +62,12 @@ int distinct_cells(const OccupancyGrid& grid, const std::vector<Eigen::Vector2d>
 namespace {
 
 // Gauss-Newton from T_start over the levels first_level..last_level, with the prior centred on
-// T_prior.
+// T_prior; with normals and MatcherConfig::normal_projection, each point matched across its
+// surface only; the normals also give the result's information (degeneracy.hpp).
 MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& points_base,
-                   const Pose2& T_start, const Pose2& T_map_base_predicted,
-                   const MatcherConfig& config, int first_level, int last_level) {
+                   const std::vector<Eigen::Vector2d>* normals, const Pose2& T_start,
+                   const Pose2& T_map_base_predicted, const MatcherConfig& config, int first_level,
+                   int last_level) {
   const Eigen::Vector3d prior_information(1.0 / std::pow(config.prior_sigma_xy_m, 2),
                                           1.0 / std::pow(config.prior_sigma_xy_m, 2),
                                           1.0 / std::pow(config.prior_sigma_theta_rad, 2));
@@ -81,7 +92,8 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
     double var = 0.0;  // map-value noise, held fixed on a level so costs stay comparable
     for (int it = 0; it < iterations; ++it) {
       const Pose2 T(xi.x(), xi.y(), xi.z());
-      const NormalEquations ne = normal_equations(grid, points_base, T);
+      const NormalEquations ne =
+          normal_equations(grid, points_base, T, config.normal_projection ? normals : nullptr);
       if (it == 0) var = std::max(min_var, ne.cost / dof);
       const Eigen::Vector3d e = prior_error(xi);
       const double cost = ne.cost / var + e.dot(P * e);
@@ -104,19 +116,40 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
     }
   }
 
-  // Covariance at the result on the finest level used (see the header for the scaling).
+  // Covariance at the result on the finest level used (see the header for the scaling), from the
+  // whole map gradient even when the match took only its part across each surface: a normal
+  // fitted through noisy points is tilted by a degree or so, and the projected gradient's share
+  // along a bare corridor's axis would claim centimetres there that nothing measures. The
+  // information degeneracy.hpp weighs is the projected one (whether or not the match used it):
+  // there that share is a thousandth of the across-wall one, a clear weak direction, where the
+  // whole gradient's pulls along the walls (the map's history) blur it.
   const OccupancyGrid& finest = maps.level(last_level);
   const Pose2 T(xi.x(), xi.y(), xi.z());
   const NormalEquations ne = normal_equations(finest, points_base, T);
   const double var = std::max(min_var, ne.cost / dof);
   const int cells = std::max(1, distinct_cells(finest, points_base, T));
   const double points_per_cell = std::max(1.0, static_cast<double>(ne.n) / cells);
-  const Eigen::Matrix3d information = ne.H / (var * points_per_cell) + P;
-  result.covariance = information.inverse();
+  result.covariance = (ne.H / (var * points_per_cell) + P).inverse();
+  const Eigen::Matrix3d H_matched =
+      normals ? normal_equations(finest, points_base, T, normals).H : ne.H;
+  result.information = H_matched / (var * points_per_cell);
   result.covariance = 0.5 * (result.covariance + result.covariance.transpose()).eval();
   result.T_map_base = T;
   result.residual_rms = ne.n > 0 ? std::sqrt(ne.cost / ne.n) : 0.0;
+  double range2 = 0.0;
+  for (const auto& p : points_base) range2 += p.squaredNorm();
+  if (!points_base.empty()) {
+    result.points_rms_range_m = std::max(1e-3, std::sqrt(range2 / points_base.size()));
+  }
   return result;
+}
+
+// The points' surface normals when the config matches across surfaces or weighs degeneracy, else
+// null.
+std::unique_ptr<std::vector<Eigen::Vector2d>> matching_normals(
+    const std::vector<Eigen::Vector2d>& points_base, const MatcherConfig& config) {
+  if (!config.normal_projection && config.degeneracy_min_ratio <= 0.0) return nullptr;
+  return std::make_unique<std::vector<Eigen::Vector2d>>(surface_normals(points_base));
 }
 
 }  // namespace
@@ -134,8 +167,9 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
                        int first_level, int last_level, const std::vector<Pose2>& other_centres) {
   if (first_level < 0 || first_level >= maps.levels()) first_level = maps.levels() - 1;
   last_level = std::clamp(last_level, 0, first_level);
-  MatchResult result = refine(maps, points_base, T_map_base_predicted, T_map_base_predicted, config,
-                              first_level, last_level);
+  const auto normals = matching_normals(points_base, config);
+  MatchResult result = refine(maps, points_base, normals.get(), T_map_base_predicted,
+                              T_map_base_predicted, config, first_level, last_level);
   if (result.residual_rms <= config.search_trigger_residual) return result;
   std::vector<Pose2> centres{T_map_base_predicted};
   centres.insert(centres.end(), other_centres.begin(), other_centres.end());
@@ -145,7 +179,7 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
         search_pose(maps.level(first_level), points_base, centre, config.search_linear_window_m,
                     config.search_angular_window_rad);
     MatchResult candidate =
-        refine(maps, points_base, T_start, centre, config, first_level, last_level);
+        refine(maps, points_base, normals.get(), T_start, centre, config, first_level, last_level);
     iterations += candidate.iterations;
     if (unverified(candidate, T_map_base_predicted, config)) continue;
     if (candidate.residual_rms < result.residual_rms) {
@@ -166,8 +200,9 @@ MatchResult match_scan_wide(const MapPyramid& maps, const std::vector<Eigen::Vec
       wide_search(maps.level(search_level), points_base, priors.front(),
                   config.wide_search_linear_window_m, config.wide_search_angular_window_rad, priors,
                   config.wide_search_temperature, T_last ? &prior : nullptr);
-  MatchResult result =
-      refine(maps, points_base, s.T_map_base, s.T_map_base, config, maps.levels() - 1, 0);
+  const auto normals = matching_normals(points_base, config);
+  MatchResult result = refine(maps, points_base, normals.get(), s.T_map_base, s.T_map_base, config,
+                              maps.levels() - 1, 0);
   // The Gauss-Newton covariance is the curvature where it ended; the search's spread adds what
   // the scan leaves open beyond it (an axis it cannot tell, a second pose that fits as well).
   result.covariance += s.covariance;

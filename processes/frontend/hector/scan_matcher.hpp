@@ -39,6 +39,13 @@ struct MatchResult {
   int points = 0;                                        // points matched
   double residual_rms = 0.0;  // RMS of 1 - M at the result, finest level [unitless]
   bool searched = false;      // the recovery search ran (and its result was kept)
+  // What the scan's surfaces measure across themselves (the gradient along each point's surface
+  // normal, surface_normals.hpp; the whole gradient when MatcherConfig::degeneracy_min_ratio and
+  // normal_projection are off), scaled as the covariance is and without the matcher's weak prior
+  // [1/m^2, 1/(m rad), 1/rad^2]; and the RMS distance of the points from the base [m]
+  // (degeneracy.hpp weighs heading against position by it).
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  double points_rms_range_m = 1.0;
 };
 
 // Estimated map-value cost and derivatives of one pose, used by the matcher and by tests.
@@ -48,9 +55,12 @@ struct NormalEquations {
   double cost = 0.0;                            // sum r^2
   int n = 0;
 };
+// With normals (base frame, one per point; zero: none), each point's map gradient is taken only
+// along its normal (surface_normals.hpp).
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
-                                 const Pose2& T_map_base);
+                                 const Pose2& T_map_base,
+                                 const std::vector<Eigen::Vector2d>* normals_base = nullptr);
 
 // Wide search around priors[0] (not empty) on pyramid level min(1, levels - 1) with a motion
 // prior towards the nearest of `priors`, then Gauss-Newton over all levels from the best pose,
