@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--profile P] [--speed S] [--offline]
 #                       [--duration S] [--deskew-off] [--set PROCESS.KEY=VALUE ...] [--tag NAME]
-#                       [--record-outputs-only] [--verdict-warns]
+#                       [--record-outputs-only] [--verdict-warns] [--wheel-encoders]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim, configs/sim.yaml and configs/rig.yaml (cached as
@@ -32,6 +32,8 @@
 #   --record-outputs-only  run.lcmlog without the sensor channels (scans, IMU, odometry, 3D truth):
 #                  what the graph published, the statuses and the 2D ground truth, all the
 #                  evaluation needs, a small part of the size
+#   --wheel-encoders  the simulated cart also publishes wheel odometry on ODOMETRY (traverse-sim
+#                  --wheel-encoders; cached and evaluated under ROUTE-seedN-PROFILE-wheels)
 #   --verdict-warns  a run whose verdict fails (run-graph exit 3: every process ran to the end
 #                  but the monitor found messages lost or a process stalled) is evaluated anyway;
 #                  the JSON's graph.ok is false (without it the script fails)
@@ -40,6 +42,7 @@ OFFLINE=""
 DESKEW_OFF=""
 RECORD_OUTPUTS_ONLY=""
 VERDICT_WARNS=""
+WHEEL_ENCODERS=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -62,6 +65,7 @@ while (($#)); do
     --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
     --record-outputs-only) RECORD_OUTPUTS_ONLY=1; shift ;;
     --verdict-warns) VERDICT_WARNS=1; shift ;;
+    --wheel-encoders) WHEEL_ENCODERS=1; shift ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $route ]] || usage; route="$1"; shift ;;
@@ -94,7 +98,7 @@ sim_config="$ROOT/configs/sim.yaml"
 rig_config="$ROOT/configs/rig.yaml"
 [[ -f $sim_config && -f $rig_config ]] || die "configs/sim.yaml or configs/rig.yaml missing"
 inputs_hash="$(cat "$route_file" "$world_file" "$sim_config" "$rig_config" | sha1sum | cut -c 1-10)"
-run_name="$route-seed$seed${duration:+-d$duration}-$profile"
+run_name="$route-seed$seed${duration:+-d$duration}-$profile${WHEEL_ENCODERS:+-wheels}"
 # Only the mapper reads the tilted profile scanner: without it the log leaves profiles out (a
 # third less to simulate and store). Every other stream is drawn from its own generator, so the
 # scans, IMU and ground truth are the same either way.
@@ -113,7 +117,7 @@ if stale "$cache" "$BIN/traverse-sim"; then
   # From the repo root: configs/sim.yaml names the rig file relative to it.
   (cd "$ROOT" && "$BIN/traverse-sim" --config configs/sim.yaml --world "$world_file" \
     --route "$route_file" --seed "$seed" --profile "$profile" "${profile_every[@]}" \
-    ${duration:+--duration "$duration"} --out "$cache.tmp" >&2) || die "traverse-sim failed"
+    ${duration:+--duration "$duration"} ${WHEEL_ENCODERS:+--wheel-encoders} --out "$cache.tmp" >&2) || die "traverse-sim failed"
   mv "$cache.tmp" "$cache"
   echo "eval-route: simulated in $((($(date +%s%N) - sim_start_ns) / 1000000)) ms" >&2
 fi
