@@ -63,7 +63,7 @@ octomap::OcTreeKey unpack(uint64_t v) {
 Mapper::Mapper(const MapperConfig& config, const Eigen::Isometry3d& T_base_laser)
     : config_(config),
       T_base_laser_(T_base_laser),
-      range_quantum_m_(config.range_max_m / 65535.0),
+      range_quantum_m_(range_quantum_m(config.range_max_m)),
       tree_(std::make_unique<octomap::OcTree>(config.resolution_m)) {
   key_scale_ = 1.0 / tree_->getResolution();  // as OcTree computes its resolution_factor
 }

@@ -106,6 +106,9 @@ struct CloudPoint {
 class Mapper {
  public:
   Mapper(const MapperConfig& config, const Eigen::Isometry3d& T_base_laser);
+  // The step a stored range is quantised to [m]: 16 bits over 0..range_max_m (what a saved
+  // state stores ranges at too, so a resumed mapper places the same points).
+  static double range_quantum_m(double range_max_m) { return range_max_m / 65535.0; }
 
   // Takes a profile; placed now if the trajectory covers it, else when it does. False if
   // malformed (sizes, times).

@@ -6,6 +6,7 @@
 #include "channels.hpp"
 #include "ply.hpp"
 #include "scan_message.hpp"
+#include "segment_message.hpp"
 
 namespace traverse::mapper {
 
@@ -55,9 +56,7 @@ void MapperNode::resume(SavedInputs& saved) {
   // The segments first (the newest revision of each, as on_segments keeps), then the profiles:
   // each is placed once, with the poses it has now, which is the map the moves had made.
   for (SavedSegment& s : saved.segments) {
-    auto known = revisions_.find(s.segment.key_id_first);
-    if (known != revisions_.end() && s.revision <= known->second) continue;
-    revisions_[s.segment.key_id_first] = s.revision;
+    if (!take_revision(s.segment.key_id_first, s.revision)) continue;
     next_key_id_ = std::max(next_key_id_, s.segment.key_id_first + 1);
     Work w = std::move(s.segment);
     apply(w);
@@ -69,6 +68,14 @@ void MapperNode::resume(SavedInputs& saved) {
   settle();
   resumed_ = Resumed{saved.profiles.size(), saved.segments.size(),
                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+}
+
+bool MapperNode::take_revision(int64_t key_id_first, int32_t revision) {
+  auto [known, added] = revisions_.try_emplace(key_id_first, revision);
+  if (added) return true;
+  if (revision <= known->second) return false;
+  known->second = revision;
+  return true;
 }
 
 void MapperNode::on_profile(const planar_scan_t& msg) {
@@ -87,17 +94,11 @@ void MapperNode::on_profile(const planar_scan_t& msg) {
 
 void MapperNode::on_segments(const dense_segments_t& msg) {
   for (const dense_segment_t& seg : msg.segments) {
-    auto known = revisions_.find(seg.key_id_first);
-    if (known != revisions_.end() && seg.revision <= known->second) {
+    if (!take_revision(seg.key_id_first, seg.revision)) {
       ++segments_stale_;
       continue;
     }
-    revisions_[seg.key_id_first] = seg.revision;
-    TrajectorySegment s;
-    s.key_id_first = seg.key_id_first;
-    s.utimes = seg.pose_utime;
-    for (int i = 0; i < seg.n_poses; ++i)
-      s.T_world_base.emplace_back(seg.x[i], seg.y[i], seg.theta[i]);
+    TrajectorySegment s = segment_of(seg);
     if (state_) state_->record(s, seg.revision);
     submit(std::move(s));
   }

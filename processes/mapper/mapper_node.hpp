@@ -98,6 +98,8 @@ class MapperNode {
   void on_pose(const pose2d_t& msg);
   void on_annotations(const annotations_t& msg);
   void cut_segment();
+  // Keeps revision as the segment's newest; false (nothing changed) when one as new is known.
+  bool take_revision(int64_t key_id_first, int32_t revision);
 
   void resume(SavedInputs& saved);
   void submit(Work work);

@@ -88,7 +88,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 MapperStateStore::MapperStateStore(std::string dir, double range_max_m)
-    : dir_(std::move(dir)), range_quantum_m_(range_max_m / 65535.0) {
+    : dir_(std::move(dir)), range_quantum_m_(Mapper::range_quantum_m(range_max_m)) {
   std::filesystem::create_directories(dir_);
 }
 

@@ -4,6 +4,7 @@
 
 #include "guidance.hpp"
 #include "message_checks.hpp"
+#include "segment_message.hpp"
 #include "traverse/process_status_t.hpp"
 
 namespace traverse::viewer {
@@ -43,13 +44,8 @@ void ViewerNode::on_preview(const cloud_preview_t& msg) {
 }
 
 void ViewerNode::on_segments(const dense_segments_t& msg) {
-  for (const dense_segment_t& s : msg.segments) {
-    mapper::TrajectorySegment seg;
-    seg.key_id_first = s.key_id_first;
-    seg.utimes = s.pose_utime;
-    for (int i = 0; i < s.n_poses; ++i) seg.T_world_base.emplace_back(s.x[i], s.y[i], s.theta[i]);
-    scene_.set_segment(seg, s.revision);
-  }
+  for (const dense_segment_t& s : msg.segments)
+    scene_.set_segment(mapper::segment_of(s), s.revision);
 }
 
 void ViewerNode::on_annotations(const annotations_t& msg) {

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 
 namespace traverse::frontend {
 namespace {
@@ -12,6 +13,13 @@ Eigen::Matrix3d scale(double length_m) {
 }
 
 }  // namespace
+
+double points_rms_range_m(const std::vector<Eigen::Vector2d>& points_base) {
+  if (points_base.empty()) return 1.0;
+  double range2 = 0.0;
+  for (const auto& p : points_base) range2 += p.squaredNorm();
+  return std::max(1e-3, std::sqrt(range2 / points_base.size()));
+}
 
 Degeneracy analyse_degeneracy(const Eigen::Matrix3d& information, double length_m,
                               double min_ratio) {

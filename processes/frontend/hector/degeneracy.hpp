@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "se2.hpp"
 
@@ -36,6 +37,10 @@ struct Degeneracy {
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();
   double length_m = 1.0;  // L
 };
+
+// L for a scan: the RMS distance of its matched points from the base [m] (1 m for no point, at
+// least 1 mm).
+double points_rms_range_m(const std::vector<Eigen::Vector2d>& points_base);
 
 // information: the match's (3x3, symmetric, [1/m^2, 1/(m rad), 1/rad^2]); length_m: L [m] (> 0).
 Degeneracy analyse_degeneracy(const Eigen::Matrix3d& information, double length_m,

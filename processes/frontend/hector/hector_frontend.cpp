@@ -146,7 +146,7 @@ Measurement HectorFrontend::measure(const Scan& scan) {
     take_match(r, match);
     // Directions the scan does not determine keep the prediction (degeneracy.hpp). Sparse scans
     // are predicted too poorly for it: their wide search's spread already says what is open.
-    if (!r.sparse) hold_degenerate(r, match, attempt.prediction);
+    if (!r.sparse) hold_degenerate(r, match, m.points_matched, attempt.prediction);
   }
   ++counters_.scans_matched;
   m.points = std::move(points.points_base);
@@ -194,8 +194,9 @@ void HectorFrontend::drop_moved(std::vector<Eigen::Vector2d>& points_base,
 }
 
 void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match,
+                                     const std::vector<Eigen::Vector2d>& points_matched,
                                      const MotionModel::Prediction& prediction) {
-  const Degeneracy dg = analyse_degeneracy(match.information, match.points_rms_range_m,
+  const Degeneracy dg = analyse_degeneracy(match.information, points_rms_range_m(points_matched),
                                            std::max(config_.matcher.degeneracy_min_ratio, 1e-12));
   r.diagnostics->degeneracy_ratio = dg.ratio;
   if (config_.matcher.degeneracy_min_ratio <= 0.0 || dg.directions == 0) return;

@@ -103,8 +103,10 @@ class HectorFrontend final : public TwoPhaseFrontend {
   // MatcherConfig::moved_max_probability), unless that is most of them.
   void drop_moved(std::vector<Eigen::Vector2d>& points_base, const Pose2& T_map_base_predicted);
   // The result's pose and covariance with the directions the scan does not determine held at
-  // the prediction (degeneracy.hpp, MatcherConfig::degeneracy_min_ratio).
+  // the prediction (degeneracy.hpp, MatcherConfig::degeneracy_min_ratio); points_matched: the
+  // points the match was made with.
   void hold_degenerate(FrontendResult& r, const MatchResult& match,
+                       const std::vector<Eigen::Vector2d>& points_matched,
                        const MotionModel::Prediction& prediction);
   // a and b lie more than a map cell or 0.01 rad apart (worth matching from both).
   bool differ(const Pose2& a, const Pose2& b) const;

@@ -136,11 +136,6 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
   result.covariance = 0.5 * (result.covariance + result.covariance.transpose()).eval();
   result.T_map_base = T;
   result.residual_rms = ne.n > 0 ? std::sqrt(ne.cost / ne.n) : 0.0;
-  double range2 = 0.0;
-  for (const auto& p : points_base) range2 += p.squaredNorm();
-  if (!points_base.empty()) {
-    result.points_rms_range_m = std::max(1e-3, std::sqrt(range2 / points_base.size()));
-  }
   return result;
 }
 

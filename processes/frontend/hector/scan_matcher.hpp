@@ -42,10 +42,8 @@ struct MatchResult {
   // What the scan's surfaces measure across themselves (the gradient along each point's surface
   // normal, surface_normals.hpp; the whole gradient when MatcherConfig::degeneracy_min_ratio and
   // normal_projection are off), scaled as the covariance is and without the matcher's weak prior
-  // [1/m^2, 1/(m rad), 1/rad^2]; and the RMS distance of the points from the base [m]
-  // (degeneracy.hpp weighs heading against position by it).
+  // [1/m^2, 1/(m rad), 1/rad^2] (degeneracy.hpp).
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  double points_rms_range_m = 1.0;
 };
 
 // Estimated map-value cost and derivatives of one pose, used by the matcher and by tests.
