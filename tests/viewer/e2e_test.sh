@@ -20,16 +20,9 @@ HERE="$BUILD/tests/viewer"
 # Route and length: long enough for the annotator's levels to pass from green to worse.
 ROUTE=office-s1 SEED=1 DURATION=50
 
-if [[ ! -x /usr/bin/chromium ]]; then
-  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends chromium \
-    >/dev/null 2>&1 || true
-fi
-if [[ ! -x /usr/bin/chromium ]]; then
-  echo "SKIP: Debian's chromium is not installed and could not be (apt-get install chromium)"
-  exit 77
-fi
-[[ -d $HERE/node_modules/playwright-core ]] ||
-  { echo "FAIL: $HERE/node_modules/playwright-core missing (the build runs npm ci there)"; exit 1; }
+# shellcheck source=tests/viewer/chromium.sh
+source "$ROOT/tests/viewer/chromium.sh"
+need_chromium "$HERE"
 
 work="$(mktemp -d /tmp/traverse-viewer-e2e.XXXXXX)"
 graph_pid=""
@@ -83,15 +76,8 @@ fi
 # The recorded run through lcm-logplayer (the viewer's channels, 4 times its pace) to a viewer on
 # a URL of this test's own.
 lcm_url="udpm://239.255.76.67:$((20000 + RANDOM % 10000))?ttl=0&recv_buf_size=8388608"
-"$BIN/traverse-viewer" --port 0 --lcm-url "$lcm_url" >"$work/replay-viewer.log" 2>&1 &
-graph_pid=$!
-url=""
-for _ in $(seq 1 100); do
-  url="$(grep -o 'open http://[0-9.:]*/' "$work/replay-viewer.log" | head -n 1 | cut -c 6-)" || true
-  [[ -n $url ]] && break
-  sleep 0.1
-done
-[[ -n $url ]] || { cat "$work/replay-viewer.log"; echo "FAIL: the replay's viewer did not start"; exit 1; }
+start_viewer "$BIN" "$lcm_url" "$work/replay-viewer.log"
+graph_pid=$viewer_pid
 lcm-logplayer -s 4 -e '^(CLOUD_PREVIEW|DENSE_SEGMENTS|ANNOTATIONS|POSE_FRONTEND|STATUS_.*)$' \
   --lcm-url="$lcm_url" "$work/run/run.lcmlog" >"$work/logplayer.out" 2>&1 &
 player=$!

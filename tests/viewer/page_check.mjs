@@ -4,7 +4,7 @@
 // its WebGL canvas. Saves a screenshot.
 //
 //   node page_check.mjs --url http://127.0.0.1:PORT/ --screenshot FILE [--timeout S]
-//                       [--min-points N] [--cut-feed] [--watch S [--no-draw]]
+//                       [--min-points N] [--cut-feed] [--watch S [--no-draw]] [--closure N]
 //
 // Two pages are opened side by side: the page as served, which must pass, and the same page with
 // its WebSocket cut (answered by a stand-in that never sends anything), which must fail: the check
@@ -14,7 +14,11 @@
 // open for S seconds, as an operator would (to measure what a connected browser costs the graph),
 // then prints what it showed and the CPU time chromium took [s]; with --no-draw the page is a
 // blank one that only reads the viewer's WebSocket (a browser on another device, as far as this
-// machine is concerned: the viewer does all its work, nothing is drawn here).
+// machine is concerned: the viewer does all its work, nothing is drawn here). --closure N watches
+// the key poses on screen while a run with loop closures is fed to the viewer, and passes when at
+// least N key poses were seen drawn in one level's colour and later, after a better level arrived,
+// in that better level's (different) colour: the colours change live where a closure shrank the
+// bounds.
 import { chromium } from 'playwright-core';
 import { mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -129,6 +133,63 @@ async function watch(context, seconds) {
   return shown;
 }
 
+// The key poses as drawn now: level, and whether the pixel at each key pose's place has its
+// level's colour (a neighbour drawn over it does not count).
+async function keysDrawn(page) {
+  return page.evaluate(() => {
+    const s = window.viewerState;
+    if (!s.legend || !window.viewer) return [];
+    window.viewer.fit();
+    window.viewer.render();
+    const gl = window.viewer.renderer.getContext();
+    const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight, px = new Uint8Array(w * h * 4);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    return window.viewer.keysOnScreen().map((k) => {
+      const rgb = s.legend.levels[k.level].rgb;
+      const i = (k.sy * w + k.sx) * 4;
+      const inside = k.sx >= 0 && k.sx < w && k.sy >= 0 && k.sy < h;
+      const drawn = inside && [0, 1, 2].every((c) => Math.abs(px[i + c] - rgb[c]) <= 2);
+      return { id: k.id, level: k.level, rgb: rgb.join(','), drawn };
+    });
+  });
+}
+
+// Key poses seen drawn in one colour and later, at a better level, in another.
+async function closure(context, result, needed) {
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(args.url);
+  const first = new Map();  // id -> the worst level it was seen drawn at, and that colour
+  const greener = new Map();  // id -> [from level, to level]
+  const deadline = Date.now() + Number(args.timeout) * 1000;
+  let looks = 0, seen = 0;
+  while (Date.now() < deadline && greener.size < needed) {
+    const keys = await keysDrawn(page);
+    ++looks;
+    seen = Math.max(seen, keys.length);
+    for (const k of keys.filter((k) => k.drawn)) {
+      const before = first.get(k.id);
+      if (before && k.level < before.level && k.rgb !== before.rgb) {
+        greener.set(k.id, [before.level, k.level]);
+      }
+      if (!before || k.level > before.level) first.set(k.id, { level: k.level, rgb: k.rgb });
+    }
+    await new Promise((r) => setTimeout(r, 250));
+  }
+  await page.screenshot({ path: args.screenshot });
+  const legend = await page.evaluate(() => window.viewerState.legend?.levels.map((l) => l.name) ?? []);
+  const names = (l) => legend[l] ?? String(l);
+  result.closure = {
+    looks, key_poses: seen, key_poses_drawn_in_their_colour: first.size,
+    greener: greener.size, needed,
+    examples: [...greener].slice(0, 5).map(([id, [a, b]]) => ({ id, from: names(a), to: names(b) })),
+    page_errors: errors,
+  };
+  result.screenshot = args.screenshot;
+  return greener.size >= needed && errors.length === 0;
+}
+
 const userDataDir = mkdtempSync(join(tmpdir(), 'traverse-chromium-'));
 const context = await chromium.launchPersistentContext(userDataDir, {
   executablePath: '/usr/bin/chromium',
@@ -174,6 +235,8 @@ try {
   if (args.watch) {
     result.watched = await watch(context, Number(args.watch));
     ok = result.watched.connected;
+  } else if (args.closure) {
+    ok = await closure(context, result, Number(args.closure));
   } else {
     ok = await check(context, result);
   }

@@ -454,6 +454,8 @@ function fit() {
   for (const s of segments.values()) {
     for (let i = 0; i < s.xy.length; i += 2) box.expandByPoint(v.set(s.xy[i], s.xy[i + 1], 0));
   }
+  // Key poses too: a viewer fed the pose graph alone (a replayed graph log) has nothing else.
+  for (const k of annotations.values()) box.expandByPoint(v.set(k.x, k.y, 0));
   if (box.isEmpty()) return;
   $('follow').checked = false;
   setView('top');
@@ -496,8 +498,21 @@ function frame() {
   requestAnimationFrame(frame);
 }
 
+// Where each key pose is drawn now: its level and its pixel in the drawing buffer (origin at the
+// bottom left, as gl.readPixels reads it).
+function keysOnScreen() {
+  const w = renderer.getContext().drawingBufferWidth, h = renderer.getContext().drawingBufferHeight;
+  const v = new THREE.Vector3();
+  return [...annotations.values()].map((k) => {
+    v.set(k.x, k.y, 0.02).project(camera);
+    return { id: k.id, level: k.level, sx: Math.round((v.x + 1) / 2 * w - 0.5),
+      sy: Math.round((v.y + 1) / 2 * h - 0.5) };
+  });
+}
+
 // For tests: draw now (the pixels are then read in the same task) and the objects drawn.
-window.viewer = { renderer, scene, render: () => renderer.render(scene, camera), cloud, keyPoints, fit };
+window.viewer = { renderer, scene, render: () => renderer.render(scene, camera), cloud, keyPoints, fit,
+  keysOnScreen };
 
 setView('top');
 connect();
