@@ -19,7 +19,7 @@ BUILD="$(cd "${1:?usage: closure_colours_test.sh BUILD_DIR [--until-utime US]}" 
 BIN="$BUILD/bin"
 HERE="$BUILD/tests/viewer"
 LOG="$ROOT/logs/court-loop_seed1_graph.lcmlog"
-NEEDED=3 SPEED=8
+NEEDED=3 SPEED=16
 # shellcheck source=tests/viewer/chromium.sh
 source "$ROOT/tests/viewer/chromium.sh"
 need_chromium "$HERE"
