@@ -172,8 +172,17 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   if (std::max(in, out_us) > 2 * std::min(in, out_us)) return;
   const Pose2 q = interpolate_between(a, b, p.utime);
   const double off = (p.T_world_base.translation() - q.translation()).norm();
-  const double chord = (b.T_world_base.translation() - a.T_world_base.translation()).norm();
-  if (off <= config_.spike_threshold_m || off <= chord) return;
+  // Turns count as travel, as the bending counts them (turn_lever_m): a turn moves the base's
+  // origin when the platform does not turn about it, so the path between two neighbours that
+  // turn is no straight line, and a pose turned off their interpolation may lie off it by the
+  // lever times that angle. A wrong match that slides along what the scan cannot fix (a corridor)
+  // keeps the heading the walls give it: off in position alone.
+  const auto lever = [&](const Pose2& u, const Pose2& v) {
+    return config_.turn_lever_m * std::abs(wrap_angle(v.theta() - u.theta()));
+  };
+  const double travel = (b.T_world_base.translation() - a.T_world_base.translation()).norm() +
+                        lever(a.T_world_base, b.T_world_base);
+  if (off <= config_.spike_threshold_m || off <= travel || off <= lever(q, p.T_world_base)) return;
   p.T_world_base = q;
   ++spikes_replaced_;
   // The segment over the pose, and the one before when a key pose sits exactly on it.
