@@ -24,6 +24,8 @@ struct Measurement {
   // The stream's recent scans came further apart than a scanner's period (its median interval
   // above MatcherConfig::wide_search_gap_us): a log subsampled by travel.
   bool subsampled_by_travel = false;
+  // Wheel odometry's step from the pose before to this scan, where the prediction took it.
+  std::optional<Pose2> odometry_step;
 };
 
 // Where to match a measurement again: around T_centre, within +-linear_window_m in x and y and

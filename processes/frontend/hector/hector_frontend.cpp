@@ -127,6 +127,7 @@ Measurement HectorFrontend::measure(const Scan& scan) {
       }
     }
     count_odometry(attempt.prediction);
+    if (attempt.prediction.odometry) m.odometry_step = attempt.prediction.odometry->T_base0_base1;
     const Pose2& T_pred = attempt.prediction.T_map_base;
     d.T_map_base_predicted = T_pred;
     const MatchResult& match = attempt.match;

@@ -49,15 +49,22 @@ std::optional<FrontendResult> SparseLag::finish() {
   return r;
 }
 
-double SparseLag::score(const Held& held, const Pose2& T, const Pose2& T_next) const {
+double SparseLag::score(const Held& held, const Pose2& T, const Pose2& T_next,
+                        const std::optional<Pose2>& odometry_next) const {
   const double evidence = inner_->evidence(held.measurement, T);
   double cost = step_prior_cost(step_prior(config_, held.T_before), T) +
                 step_prior_cost(step_prior(config_, T), T_next);
   if (recent_steps_m_.size() >= kRecentSteps / 2) {
-    const double limit = kLongStepFactor * recent_steps_m_.percentile(90);
-    for (const double length : {between(held.T_before, T).translation().norm(),
-                                between(T, T_next).translation().norm()}) {
-      const double e = std::max(0.0, length - limit) / kLongStepScaleM;
+    // A step odometry measured long is not long for the log: its limit grows with it.
+    const auto limit = [&](const std::optional<Pose2>& odometry) {
+      const double usual = recent_steps_m_.percentile(90);
+      return kLongStepFactor * (odometry ? std::max(usual, odometry->translation().norm()) : usual);
+    };
+    const std::pair<double, double> steps[] = {
+        {between(held.T_before, T).translation().norm(), limit(held.measurement.odometry_step)},
+        {between(T, T_next).translation().norm(), limit(odometry_next)}};
+    for (const auto& [length, limit_m] : steps) {
+      const double e = std::max(0.0, length - limit_m) / kLongStepScaleM;
       cost += config_.sparse_lag_long_weight * e * e;
     }
   }
@@ -71,8 +78,11 @@ FrontendResult SparseLag::settle(Held held, Measurement* next) {
     // Where the scan fits best may not be where it was (a room mapped differently on an earlier
     // pass): the pose halfway between the steps around it is a second candidate, matched in a
     // narrow window, and the better of the two by the lag's score is kept.
+    // With wheel odometry the second candidate is where odometry's step puts the scan, not
+    // halfway: one step of a pair may be much longer than the other.
     const Pose2& T_next = next->result.T_map_base;
-    const Pose2 mid = interpolate(held.T_before, T_next, 0.5);
+    const Pose2 mid = k.odometry_step ? held.T_before * *k.odometry_step
+                                      : interpolate(held.T_before, T_next, 0.5);
     const Pose2 d = between(mid, k.result.T_map_base);
     if (d.translation().norm() > config_.sparse_lag_window_m ||
         std::abs(d.theta()) > config_.sparse_lag_window_rad) {
@@ -80,8 +90,8 @@ FrontendResult SparseLag::settle(Held held, Measurement* next) {
       undone = true;
       const Measurement alt = inner_->rematch(
           k, {mid, config_.sparse_lag_window_m, config_.sparse_lag_window_rad, held.T_before});
-      const double own = score(held, k.result.T_map_base, T_next);
-      const double other = score(held, alt.result.T_map_base, T_next);
+      const double own = score(held, k.result.T_map_base, T_next, next->odometry_step);
+      const double other = score(held, alt.result.T_map_base, T_next, next->odometry_step);
       if (!poses_agree(alt.result.T_map_base, k.result.T_map_base)) {
         const Pose2 T_own = k.result.T_map_base;
         revised = other > own + config_.sparse_lag_margin;
