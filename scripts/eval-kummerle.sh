@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # scripts/eval-kummerle.sh NAME|PATH [--relations FILE] [--stages LIST] [--offline] [--speed S]
+#                          [--set PROCESS.KEY=VALUE ...] [--tag NAME]
 # scripts/eval-kummerle.sh --all [--offline] [--speed S]
 #
 # The relations benchmark (Kümmerle et al. 2009) on a full-rate CARMEN log: converts
@@ -22,6 +23,8 @@
 #                  live on a bus: no transport loss, as fast as they compute, the same figures
 #                  every time; --speed is then ignored
 #   --speed S      live replay speed, times the log's pace (default 1)
+#   --set, --tag   as scripts/eval-route.sh's (outputs under out/eval/kummerle-NAME-STAGES-TAG/;
+#                  the JSON's config_sets lists what was set)
 #   --all          intel, aces and fr079, each with the frontend alone and the full graph: one
 #                  Markdown table beside the published figures (Hess et al. 2016, Table II) and
 #                  wall-clock times against the logs' durations (Cartographer: Table V)
@@ -30,7 +33,7 @@ OFFLINE=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
-what="" stages="frontend,backend,densifier" speed=1 relations="" all=""
+what="" stages="frontend,backend,densifier" speed=1 relations="" all="" tag=""
 while (($#)); do
   case "$1" in
     --stages) stages="${2:?--stages needs a list}"; shift 2 ;;
@@ -38,6 +41,8 @@ while (($#)); do
     --speed) speed="${2:?--speed needs a number}"; shift 2 ;;
     --offline) OFFLINE=1; shift ;;
     --all) all=1; shift ;;
+    --set) CONFIG_SETS+=("${2:?--set needs PROCESS.KEY=VALUE}"); shift 2 ;;
+    --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $what ]] || usage; what="$1"; shift ;;
@@ -45,8 +50,9 @@ while (($#)); do
 done
 command -v python3 >/dev/null || die "python3 is needed to read the JSON (scripts/setup.sh)"
 
+[[ -z $tag || $tag =~ ^[A-Za-z0-9._-]+$ ]] || die "--tag must be a plain name, not '$tag'"
 if [[ -n $all ]]; then
-  [[ -z $what && -z $relations ]] || usage
+  [[ -z $what && -z $relations && -z $tag && ${#CONFIG_SETS[@]} -eq 0 ]] || usage
   exec python3 "$ROOT/scripts/kummerle_table.py" "$0" ${OFFLINE:+--offline} --speed "$speed"
 fi
 [[ -n $what && -n $stages ]] || usage
@@ -77,7 +83,7 @@ PY
 log_s="$driver_facts"
 
 # 2. The stages on it, 3. the last stage's trajectory scored by the relations.
-out="$ROOT/out/eval/kummerle-$name-$(stages_tag "$stages")"
+out="$ROOT/out/eval/kummerle-$name-$(stages_tag "$stages")${tag:+-$tag}"
 rm -rf "$out"
 mkdir -p "$out"
 run_graph "$cache" "$out" "$stages" "$speed"
@@ -93,14 +99,14 @@ echo "eval-kummerle: $name stages $stages: outputs in $out" >&2
 
 # One JSON object: what was run and scored first, then the evaluator's figures, the graph's JSON.
 python3 - "$name" "$input" "$relations" "$stages" "$channel" "$out/run.lcmlog" "$log_s" \
-  "${OFFLINE:+true}" "$speed" "$EVAL_JSON" "${GRAPH_JSON:-null}" <<'PY'
+  "${OFFLINE:+true}" "$speed" "$EVAL_JSON" "${GRAPH_JSON:-null}" "$(config_sets_json)" <<'PY'
 import json, sys
-name, log, relations, stages, channel, scored, log_s, offline, speed, ev, graph = sys.argv[1:]
+name, log, relations, stages, channel, scored, log_s, offline, speed, ev, graph, sets = sys.argv[1:]
 graph = json.loads(graph)
 head = {"kummerle": name, "input": log, "relations_file": relations, "stages": stages,
         "offline": offline == "true", "speed": float(speed), "channel": channel,
         "scored_log": scored, "wall_s": graph["duration_s"] if graph else None,
-        "log_s": round(float(log_s), 3)}
+        "log_s": round(float(log_s), 3), "config_sets": json.loads(sets)}
 print(json.dumps({**head, **json.loads(ev), "graph": graph}))
 PY
 ((rc == 0)) || { tail -n 3 "$out/evaluator.log" >&2; die "the evaluation was refused (exit $rc)"; }

@@ -54,19 +54,23 @@ struct MatcherConfig {
   double min_residual_sigma = 0.02;  // floor of the map-value noise used to scale covariances
   // Match each point only across its own surface (hector/surface_normals.hpp): the map's
   // gradient along a wall (where the map's wall ends, a far wall's dotted cells) pulls a
-  // corridor's scan along the axis that nothing else holds. Off: on the relations log intel it
-  // loses the track (mean translational error 2.25 m against 0.021 m without), and on the
-  // simulated corridor-return it bought little (README, "What each change bought").
+  // corridor's scan along the axis that nothing else holds. Applied only to scans predicted with
+  // odometry (HectorFrontend::matcher_for), which then holds that axis (degeneracy_min_ratio):
+  // without odometry it lets a corridor slide (corridor-return, IMU alone, with the two keys
+  // below: 7.8 m RMSE). Off by default with the two keys below (docs/frontends.md, "The
+  // spread").
   bool normal_projection = false;
   // Degeneracy (hector/degeneracy.hpp): eigen-directions of the scan's information (heading
   // weighed as the arc it moves the points through) below this share of the largest are held at
-  // the motion prediction, and take its covariance. 0 never holds any.
+  // the odometry prediction, and take the prediction's covariance. 0 never holds any.
   double degeneracy_min_ratio = 0.0;
   // On a scanner's stream, points where the map (level 1) holds only cells below this occupancy
   // probability all around, at the predicted pose, are left out of the match and the map
-  // (hector/moved_points.hpp: people walking through, mixed pixels). 0 keeps every point. 0.25 on
-  // corridor-return (realistic, seed 1, wheel odometry): RMSE 11.6 m -> 0.83 m; but the relations
-  // log aces 0.0386 -> 0.0413 m and the regression log's RMSE +5 %: off until more seeds decide.
+  // (hector/moved_points.hpp: people walking through, mixed pixels). 0 keeps every point. 0.25
+  // with the two keys above (0.03, true) wins on every simulated route with odometry (metres on
+  // corridor-return, office-s2, office-s3) but loses the relations log aces on 2 of 4 starts a
+  // centimetre or a milliradian apart (0.21, 0.32 m against 0.039-0.045 m off), and the
+  // regression log's RMSE is 5 % worse: off (docs/frontends.md, "The spread").
   double moved_max_probability = 0.0;
   // Recovery: when the RMS of 1 - M after Gauss-Newton exceeds this, the prediction was too far
   // off for gradient steps (a fast turn between sparse scans): search exhaustively on the

@@ -80,6 +80,18 @@ TEST(Frontend, TracksWithoutImu) {
   EXPECT_EQ(run.counters.at("imu_samples"), 0);
 }
 
+// Normal projection frees the axis along a surface for odometry to hold (matcher_for): a stream
+// without odometry is matched on the whole gradient, to the bit, whatever the key says.
+TEST(Frontend, NormalProjectionOnlyWhereOdometryPredicts) {
+  FrontendConfig projected;
+  projected.matcher.normal_projection = true;
+  const RoomRun with = run_room(projected, true, 0.4);
+  const RoomRun without = run_room(FrontendConfig{}, true, 0.4);
+  EXPECT_EQ(with.position_error_m, without.position_error_m);
+  EXPECT_EQ(with.heading_error_rad, without.heading_error_rad);
+  EXPECT_LT(with.position_error_m, 0.005);
+}
+
 // The ICP frontend (icp/) through the same walk: the same messages, the same accuracy.
 TEST(Frontend, IcpKindTracksWalkThroughRoomWithAndWithoutImu) {
   FrontendConfig config;

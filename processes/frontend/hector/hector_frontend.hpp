@@ -115,8 +115,9 @@ class HectorFrontend final : public TwoPhaseFrontend {
   // a's pose lies more than `sigmas` standard deviations of b's covariance from b's.
   static bool apart(const Attempt& a, const Attempt& b, double sigmas);
   void count_odometry(const MotionModel::Prediction& prediction);
-  // The matcher's config with the searches' windows sized by the prediction's odometry step.
-  MatcherConfig search_windows(const MotionModel::Prediction& prediction) const;
+  // The matcher's config for a prediction: the searches' windows sized by its odometry step;
+  // normal projection only with odometry.
+  MatcherConfig matcher_for(const MotionModel::Prediction& prediction) const;
 
   FrontendConfig config_;
   Pose2 T_initial_;
