@@ -31,7 +31,8 @@
 #                   the address and port)
 # Products: trajectory.tum (TUM format: evo and other tools read it), trajectory.csv (with the
 # covariance of every pose), ground_truth.tum, cloud.ply and cloud.las (LAS 1.4: GPS time,
-# intensity, accuracy colour, level), map.bt and map.ot (OctoMap), report.json, report.md with
+# intensity, accuracy colour, level), map.bt and map.ot (OctoMap), map_colour.ot (the OctoMap
+# with each voxel in the accuracy colour of the worst level of its points), report.json, report.md with
 # trajectory.png and errors.png, run.lcmlog, monitor.json, and logs/ (every process's output, the
 # evaluation's and the export's JSON, errors.csv, closures.csv). The input log it simulates (or
 # converts) is removed at the end: run.lcmlog holds every message of it.
@@ -158,14 +159,14 @@ rm -f "$out/monitor.json" "$out/errors.png"
 # (What an earlier demo left here: a CARMEN run writes reference.tum, a simulated one
 # ground_truth.tum, and no other run's product may stand beside this one's.)
 (cd "$out" && rm -f trajectory.tum trajectory.csv ground_truth.tum reference.tum cloud.ply \
-  cloud.las map.bt map.ot report.json report.md trajectory.png run.lcmlog)
+  cloud.las map.bt map.ot map_colour.ot report.json report.md trajectory.png run.lcmlog)
 for f in monitor.json errors.png; do
   [[ -e $run_dir/$f ]] && mv "$run_dir/$f" "$out/$f"
 done
 export_args=(--reference POSE_GROUND_TRUTH)
 [[ -n $carmen ]] && export_args=(--reference POSE_REFERENCE)
 if [[ -f $run_dir/mapper/cloud.ply ]]; then
-  mv "$run_dir/mapper/map.bt" "$run_dir/mapper/map.ot" "$out/"
+  mv "$run_dir/mapper/map.bt" "$run_dir/mapper/map.ot" "$run_dir/mapper/map_colour.ot" "$out/"
   export_args+=(--cloud "$run_dir/mapper/cloud.ply")
 fi
 "$ROOT/build/bin/traverse-export" --log "$run_dir/run.lcmlog" "${export_args[@]}" --out "$out" \

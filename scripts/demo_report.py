@@ -22,6 +22,7 @@ PRODUCTS = [  # (file, what)
     ("cloud.las", "point cloud, LAS 1.4 (GPS time, intensity, accuracy colour, level)"),
     ("map.bt", "OctoMap, binary (map frame, whatever --frame says: a voxel grid does not turn)"),
     ("map.ot", "OctoMap, full (map frame)"),
+    ("map_colour.ot", "OctoMap, voxels in the accuracy colour of the worst level of their points"),
     ("report.md", "accuracy report, Markdown"),
     ("report.json", "accuracy report, every figure"),
     ("trajectory.png", "trajectory plot"),

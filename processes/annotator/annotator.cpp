@@ -76,11 +76,11 @@ bool Annotator::add_edge(int index, int64_t from_id, int64_t to_id, const Pose2&
   return true;
 }
 
-std::map<int64_t, double> Annotator::local_bounds(const std::vector<int64_t>& ids) {
-  std::map<int64_t, double> out;
+Annotator::LocalBounds Annotator::local_bounds(const std::vector<int64_t>& ids) {
+  LocalBounds out;
   // The backend's ids are its graph's vertex indices 0..n-1; the graph needs all of them.
   const int n = static_cast<int>(keys_.size());
-  if (n == 1 && keys_.begin()->first == 0) return {{0, 0.0}};  // no neighbour: nothing relative
+  if (n == 1 && keys_.begin()->first == 0) return {{{0, 0.0}}, {}};  // nothing relative
   if (n < 2 || keys_.rbegin()->first != n - 1 || edges_.empty()) return out;
   backend::PoseGraph graph;
   for (const auto& [id, key] : keys_) graph.add_vertex(id, key.T_world_base, id == 0);
@@ -103,20 +103,31 @@ std::map<int64_t, double> Annotator::local_bounds(const std::vector<int64_t>& id
     double floor_m = 0.0;
     for (int j = 0; j < n; ++j) {
       if (j == i || (graph.poses[j].translation() - T_i.translation()).squaredNorm() > r2) continue;
+      const Eigen::Matrix3d S_ij = joint_.cross(j).transpose();  // E[dx_i dx_j^T]
       const Eigen::Matrix2d c =
-          config_.covariance_scale *
-          relative_position_covariance(T_i, graph.poses[j], joint_.marginal(i), joint_.marginal(j),
-                                       joint_.cross(j).transpose());
+          config_.covariance_scale * relative_position_covariance(T_i, graph.poses[j],
+                                                                  joint_.marginal(i),
+                                                                  joint_.marginal(j), S_ij);
       const double l1 = largest_eigenvalue(c);
       floor_m = std::max(floor_m, kNormal975 * std::sqrt(std::max(l1, 0.0)));
       near.emplace_back(l1, c);
+      // The same column gives i seen from j: j's local bound has a new or moved neighbour.
+      if (std::binary_search(ids.begin(), ids.end(), static_cast<int64_t>(j))) continue;
+      const Eigen::Matrix2d c_j =
+          config_.covariance_scale *
+          relative_position_covariance(graph.poses[j], T_i, joint_.marginal(j), joint_.marginal(i),
+                                       S_ij.transpose());
+      double& term = out.neighbours.try_emplace(j, 0.0).first->second;
+      if (std::sqrt(kChi2TwoDof95 * std::max(largest_eigenvalue(c_j), 0.0)) > term) {
+        term = std::max(term, bound_95(c_j, method_));
+      }
     }
     double best = 0.0;
     for (const auto& [l1, c] : near) {
       if (std::sqrt(kChi2TwoDof95 * std::max(l1, 0.0)) < floor_m) continue;
       best = std::max(best, bound_95(c, method_));
     }
-    out[id] = best;
+    out.recomputed[id] = best;
   }
   return out;
 }
@@ -131,10 +142,21 @@ bool Annotator::differs(const Annotation& a, const Annotation& b) const {
 std::vector<Annotation> Annotator::update() {
   std::sort(dirty_.begin(), dirty_.end());
   dirty_.erase(std::unique(dirty_.begin(), dirty_.end()), dirty_.end());
-  std::map<int64_t, double> local;
+  LocalBounds local;
   if (config_.local_radius_m > 0.0 && !dirty_.empty()) local = local_bounds(dirty_);
   std::vector<Annotation> out;
   last_level_changes_ = 0;
+  const auto settle = [&](Annotation a) {
+    // Coloured by the local bound when asked and known, else by the absolute one.
+    const bool by_local = config_.colour_by == "local" && a.local_bound_m >= 0.0;
+    a.level = legend_.level_of(by_local ? a.local_bound_m : a.bound_m);
+    a.rgb = legend_.levels()[a.level].rgb;
+    auto it = published_.find(a.id);
+    if (it != published_.end() && !differs(a, it->second)) return;
+    if (it != published_.end() && it->second.level != a.level) ++last_level_changes_;
+    published_[a.id] = a;
+    out.push_back(a);
+  };
   for (int64_t id : dirty_) {
     const Key& k = keys_.at(id);
     Annotation a;
@@ -142,16 +164,21 @@ std::vector<Annotation> Annotator::update() {
     a.utime = k.utime;
     a.T_world_base = k.T_world_base;
     a.bound_m = bound_95(config_.covariance_scale * translational(k.covariance), method_);
-    if (auto it = local.find(id); it != local.end()) a.local_bound_m = it->second;
-    // Coloured by the local bound when asked and known, else by the absolute one.
-    const bool by_local = config_.colour_by == "local" && a.local_bound_m >= 0.0;
-    a.level = legend_.level_of(by_local ? a.local_bound_m : a.bound_m);
-    a.rgb = legend_.levels()[a.level].rgb;
+    if (auto it = local.recomputed.find(id); it != local.recomputed.end()) {
+      a.local_bound_m = it->second;
+    }
+    settle(a);
+  }
+  // A key pose the backend did not resend but with a new or moved key pose within
+  // local_radius_m: its local bound takes that neighbour too. Its other terms stay as computed
+  // before: the graph has only gained information since, which never raises a covariance, so a
+  // kept term is no smaller than a recomputed one (to first order) until the key pose is resent.
+  for (const auto& [id, term] : local.neighbours) {
     auto it = published_.find(id);
-    if (it != published_.end() && !differs(a, it->second)) continue;
-    if (it != published_.end() && it->second.level != a.level) ++last_level_changes_;
-    published_[id] = a;
-    out.push_back(a);
+    if (it == published_.end() || it->second.local_bound_m < 0.0) continue;
+    Annotation a = it->second;
+    a.local_bound_m = std::max(a.local_bound_m, term);
+    settle(a);
   }
   dirty_.clear();
   counters_.annotations_changed += static_cast<long>(out.size());

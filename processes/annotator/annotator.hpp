@@ -98,6 +98,7 @@ class Annotator {
   // Recomputes the key poses set since the last call and returns the annotations that are new or
   // changed (level, or a bound by republish_fraction).
   std::vector<Annotation> update();
+  std::size_t key_poses_held() const { return keys_.size(); }
   // Every annotation, by id.
   const std::map<int64_t, Annotation>& annotations() const { return published_; }
   const Legend& legend() const { return legend_; }
@@ -112,8 +113,14 @@ class Annotator {
     Pose2 T_world_base;
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   };
-  // Local bounds of `ids` (those not computable stay -1).
-  std::map<int64_t, double> local_bounds(const std::vector<int64_t>& ids);
+  struct LocalBounds {
+    std::map<int64_t, double> recomputed;  // [m] local bound of each of `ids` computable
+    std::map<int64_t, double> neighbours;  // [m] other key poses: worst term of one of `ids`
+  };
+  // Local bounds of `ids` (sorted; those not computable are left out), and for every other key
+  // pose within local_radius_m of one of them the largest 95 % radius of one of them seen from it
+  // (the same columns of the joint covariance give both).
+  LocalBounds local_bounds(const std::vector<int64_t>& ids);
   bool differs(const Annotation& a, const Annotation& b) const;
 
   AnnotatorConfig config_;

@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "config.hpp"
+#include "traverse/graph_request_t.hpp"
 
 namespace traverse::annotator {
 namespace {
@@ -94,9 +95,28 @@ AnnotatorNode::AnnotatorNode(Bus& bus, const AnnotatorNodeConfig& config, Counte
       config_.edges_channel, [this](const pose_graph_edges_t& m) { on_edges(m); }, true);
   bus_.subscribe<key_poses_t>(
       config_.key_poses_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
+  if (config_.graph_request_channel.empty()) return;
+  // The backend's answers to a graph request: the whole graph, read like an update.
+  bus_.subscribe<pose_graph_edges_t>(
+      channels::kPoseGraphEdgesFull, [this](const pose_graph_edges_t& m) { on_edges(m); }, true);
+  bus_.subscribe<key_poses_t>(
+      channels::kKeyPosesFull, [this](const key_poses_t& m) { on_key_poses(m); }, true);
+  request_graph();  // a backend already running has a graph this node has not seen
+}
+
+void AnnotatorNode::request_graph() {
+  if (config_.graph_request_channel.empty() || requested_at_ == optimisation_) return;
+  graph_request_t m{};
+  m.utime = utime_;
+  m.edges_held = static_cast<int32_t>(annotator_.counters().edges);
+  m.key_poses_held = static_cast<int32_t>(annotator_.key_poses_held());
+  bus_.publish(config_.graph_request_channel, m);
+  requested_at_ = optimisation_;
+  ++graph_requests_;
 }
 
 void AnnotatorNode::on_edges(const pose_graph_edges_t& msg) {
+  graph_edges_ = std::max(graph_edges_, msg.total_edges);
   for (const pose_graph_edge_t& e : msg.edges) {
     annotator_.add_edge(e.index, e.from_id, e.to_id, Pose2(e.x, e.y, e.theta),
                         matrix(e.information));
@@ -111,6 +131,7 @@ void AnnotatorNode::on_key_poses(const key_poses_t& msg) {
   optimisation_ = std::max(optimisation_, msg.optimisation);
   if (msg.n_closures > 0) closure_pending_ = true;
   loop_closures_ = std::max(loop_closures_, msg.total_loop_closures);
+  graph_key_poses_ = std::max(graph_key_poses_, msg.total_key_poses);
   // All parts of the optimisation are in (a lost part only delays its key poses to the next one).
   if (msg.part + 1 < msg.parts) return;
   const auto t0 = std::chrono::steady_clock::now();
@@ -123,6 +144,11 @@ void AnnotatorNode::on_key_poses(const key_poses_t& msg) {
       closure_pending_ ? annotations_t::REASON_LOOP_CLOSURE : annotations_t::REASON_NEW;
   closure_pending_ = false;
   if (!changed.empty()) publish(changed, reason, annotator_.last_level_changes());
+  // Something was missed (started late, or a message lost): ask for the whole graph.
+  if (annotator_.key_poses_held() < static_cast<std::size_t>(graph_key_poses_) ||
+      annotator_.counters().edges < graph_edges_) {
+    request_graph();
+  }
 }
 
 void AnnotatorNode::publish(const std::vector<Annotation>& annotations, int8_t reason,
@@ -157,6 +183,7 @@ void AnnotatorNode::report_counters() {
   counters_("updates", updates_);
   counters_("update_total_s", update_s_total_);
   counters_("update_max_s", update_s_max_);
+  counters_("graph_requests", graph_requests_);
 }
 
 }  // namespace traverse::annotator

@@ -4,6 +4,13 @@
 // (annotations_t on ANNOTATIONS, with the legend, in parts of at most max_keys_per_message). At
 // the end of data every annotation is sent once more (REASON_FINAL), so a late listener or the
 // recorded log's last word holds them all.
+//
+// Joining late: the backend's updates are incremental, so an annotator that starts after the
+// backend, or misses an edge or key pose message, holds part of the graph and can compute no
+// local bound. It asks for the whole graph (graph_request_t on graph_request_channel) when it
+// starts and after every optimisation that leaves it holding fewer key poses or edges than the
+// backend says the graph has; the backend answers on KEY_POSES_FULL and POSE_GRAPH_EDGES_FULL
+// (backend_node.hpp), which this node reads like the incremental channels.
 #pragma once
 
 #include <functional>
@@ -24,6 +31,7 @@ struct AnnotatorNodeConfig {
   std::string key_poses_channel = channels::kKeyPoses;
   std::string edges_channel = channels::kPoseGraphEdges;
   std::string annotations_channel = channels::kAnnotations;
+  std::string graph_request_channel = channels::kGraphRequest;  // "": never ask for the graph
   int max_keys_per_message = 1000;  // 52 bytes each: a part stays under 64 KB
   AnnotatorConfig annotator;        // its keys sit at the top level of the file
 
@@ -32,6 +40,7 @@ struct AnnotatorNodeConfig {
     v("key_poses_channel", key_poses_channel);
     v("edges_channel", edges_channel);
     v("annotations_channel", annotations_channel);
+    v("graph_request_channel", graph_request_channel);
     v("max_keys_per_message", max_keys_per_message);
     annotator.visit(v);
   }
@@ -62,6 +71,8 @@ class AnnotatorNode {
   void on_edges(const pose_graph_edges_t& msg);
   void on_key_poses(const key_poses_t& msg);
   void publish(const std::vector<Annotation>& annotations, int8_t reason, int32_t changed_level);
+  // Asks the backend for its whole graph (at most once per optimisation heard).
+  void request_graph();
 
   Bus& bus_;
   AnnotatorNodeConfig config_;
@@ -71,6 +82,9 @@ class AnnotatorNode {
   int32_t optimisation_ = 0;   // newest optimisation heard
   int32_t loop_closures_ = 0;  // loop closures in the graph
   bool closure_pending_ = false;
+  int32_t graph_key_poses_ = 0, graph_edges_ = 0;  // the backend's graph, as its messages say
+  int32_t requested_at_ = -1;                      // optimisation of the last graph request
+  double graph_requests_ = 0;
   double messages_ = 0, updates_ = 0, update_s_total_ = 0, update_s_max_ = 0;
 };
 

@@ -26,6 +26,7 @@ std::optional<std::string> validate(const BackendNodeConfig& c) {
   check.not_empty("key_poses_channel", c.key_poses_channel);
   check.not_empty("trajectory_channel", c.trajectory_channel);
   check.not_empty("edges_channel", c.edges_channel);
+  check.in_range("graph_resend_min_s", c.graph_resend_min_s, 0.0, 3600.0);
   check.in_range("max_poses_per_message", c.max_poses_per_message, 1, 580);
   check.not_negative("publish_move_m", c.publish_move_m);
   check.not_negative("publish_turn_rad", c.publish_turn_rad);
@@ -49,6 +50,33 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
     bus_.subscribe<odometry_t>(config_.odometry_channel,
                                [this](const odometry_t& m) { on_odometry(m); });
   }
+  // Requests from several listeners interleave: their times need not be in order.
+  if (!config_.graph_request_channel.empty()) {
+    bus_.subscribe<graph_request_t>(
+        config_.graph_request_channel, [this](const graph_request_t& m) { on_graph_request(m); },
+        true);
+  }
+}
+
+void BackendNode::on_graph_request(const graph_request_t&) {
+  ++graph_requests_;
+  // The graph as last published: key poses and edges added since wait for the next update.
+  const std::size_t n_keys = published_.size();
+  // An empty graph needs no answer: the listener gets all of it from the updates to come. A
+  // request soon after an answer is dropped: the answer went to every listener, and one that
+  // still lacks something asks again after the next optimisation.
+  if (n_keys == 0) return;
+  const int64_t newest = backend_.key_poses()[n_keys - 1].utime;
+  if (graph_answers_ > 0 &&
+      newest - last_answer_utime_ < std::llround(config_.graph_resend_min_s * 1e6)) {
+    return;
+  }
+  std::vector<int> all(n_keys);
+  for (std::size_t i = 0; i < n_keys; ++i) all[i] = static_cast<int>(i);
+  publish_edges(0, edges_published_, last_update_.optimisation, channels::kPoseGraphEdgesFull);
+  publish_key_poses(all, n_keys, last_update_, channels::kKeyPosesFull);
+  last_answer_utime_ = newest;
+  ++graph_answers_;
 }
 
 void BackendNode::on_odometry(const odometry_t& msg) {
@@ -89,25 +117,24 @@ bool BackendNode::changed(int i) const {
   return false;
 }
 
-// The key-pose edges appended since the last call (Backend::key_edges: the drift model's
-// auxiliary vertices are not published).
-void BackendNode::publish_new_edges(int32_t optimisation) {
+// The key-pose edges [first, last) (Backend::key_edges: the drift model's auxiliary vertices are
+// not published).
+void BackendNode::publish_edges(std::size_t first, std::size_t last, int32_t optimisation,
+                                const std::string& channel) {
   const std::vector<KeyEdge>& edges = backend_.key_edges();
   const std::vector<KeyPose>& keys = backend_.key_poses();
   // 125 bytes per edge: at most 500 keep a part under 64 KB.
   const std::size_t per = static_cast<std::size_t>(std::min(config_.max_poses_per_message, 500));
-  const std::size_t first = edges_published_;
-  const int parts = static_cast<int>((edges.size() - first + per - 1) / per);
+  const int parts = static_cast<int>((last - first + per - 1) / per);
   for (int part = 0; part < parts; ++part) {
     pose_graph_edges_t msg{};
     msg.utime = keys.back().utime;
     msg.optimisation = optimisation;
     msg.part = part;
     msg.parts = parts;
-    msg.total_edges = static_cast<int32_t>(edges.size());
+    msg.total_edges = static_cast<int32_t>(last);
     msg.first_index = static_cast<int32_t>(first + part * per);
-    for (std::size_t k = msg.first_index; k < std::min(edges.size(), first + (part + 1) * per);
-         ++k) {
+    for (std::size_t k = msg.first_index; k < std::min(last, first + (part + 1) * per); ++k) {
       const KeyEdge& e = edges[k];
       pose_graph_edge_t m{};
       m.utime = keys[e.to].utime;
@@ -124,40 +151,63 @@ void BackendNode::publish_new_edges(int32_t optimisation) {
       msg.edges.push_back(m);
     }
     msg.n_edges = static_cast<int32_t>(msg.edges.size());
-    bus_.publish(config_.edges_channel, msg);
+    bus_.publish(channel, msg);
   }
-  edges_published_ = edges.size();
 }
 
 void BackendNode::publish(const BackendUpdate& update) {
   const std::vector<KeyPose>& keys = backend_.key_poses();
-  const PoseGraph& graph = backend_.graph();
   if (keys.empty()) return;
-  publish_new_edges(update.optimisation);
+  publish_edges(edges_published_, backend_.key_edges().size(), update.optimisation,
+                config_.edges_channel);
+  edges_published_ = backend_.key_edges().size();
   std::vector<int> changed_ids;
   for (int i = 0; i < static_cast<int>(keys.size()); ++i) {
     if (changed(i)) changed_ids.push_back(i);
   }
   published_.resize(keys.size());
   for (int i : changed_ids) published_[i] = {keys[i].T_world_base, keys[i].covariance.diagonal()};
+  publish_key_poses(changed_ids, keys.size(), update, config_.key_poses_channel);
+  last_update_ = update;
+  last_update_.new_key_poses.clear();
+  last_update_.new_closures.clear();
 
+  // The trajectory for evaluators: each new key pose once, at its estimate of this optimisation.
+  for (int i : update.new_key_poses) {
+    pose2d_t pose{};
+    pose.utime = keys[i].utime;
+    pose.parent_frame = "map";  // the frontend's frame, which the graph keeps
+    pose.child_frame = "base";
+    pose.x = keys[i].T_world_base.x();
+    pose.y = keys[i].T_world_base.y();
+    pose.theta = keys[i].T_world_base.theta();
+    copy_matrix(keys[i].covariance, pose.covariance);
+    pose.flags = pose2d_t::FLAG_KEY_POSE;
+    bus_.publish(config_.trajectory_channel, pose);
+  }
+  if (state_) state_->persist(backend_);
+}
+
+void BackendNode::publish_key_poses(const std::vector<int>& ids, std::size_t n_keys,
+                                    const BackendUpdate& update, const std::string& channel) {
+  const std::vector<KeyPose>& keys = backend_.key_poses();
   const int per = config_.max_poses_per_message;
-  const int parts = std::max(1, static_cast<int>((changed_ids.size() + per - 1) / per));
-  const double chi2_now = chi2(graph);
+  const int parts = std::max(1, static_cast<int>((ids.size() + per - 1) / per));
+  const double chi2_now = chi2(backend_.graph());
   for (int part = 0; part < parts; ++part) {
     key_poses_t msg{};
-    msg.utime = keys.back().utime;
+    msg.utime = keys[n_keys - 1].utime;
     msg.optimisation = update.optimisation;
     msg.part = part;
     msg.parts = parts;
-    msg.total_key_poses = static_cast<int32_t>(keys.size());
+    msg.total_key_poses = static_cast<int32_t>(n_keys);
     msg.total_loop_closures = static_cast<int32_t>(backend_.closures().size());
     msg.optimisation_s = update.optimisation_s;
     msg.chi2 = chi2_now;
     const std::size_t lo = static_cast<std::size_t>(part) * per;
-    const std::size_t hi = std::min(changed_ids.size(), lo + per);
+    const std::size_t hi = std::min(ids.size(), lo + per);
     for (std::size_t k = lo; k < hi; ++k) {
-      const int i = changed_ids[k];
+      const int i = ids[k];
       key_pose_t p{};
       p.utime = keys[i].utime;
       p.id = i;
@@ -187,24 +237,9 @@ void BackendNode::publish(const BackendUpdate& update) {
     msg.n_closures = static_cast<int32_t>(msg.closures.size());
     max_message_bytes_ =
         std::max(max_message_bytes_, static_cast<std::size_t>(msg.getEncodedSize()));
-    bus_.publish(config_.key_poses_channel, msg);
+    bus_.publish(channel, msg);
     ++messages_;
   }
-
-  // The trajectory for evaluators: each new key pose once, at its estimate of this optimisation.
-  for (int i : update.new_key_poses) {
-    pose2d_t pose{};
-    pose.utime = keys[i].utime;
-    pose.parent_frame = "map";  // the frontend's frame, which the graph keeps
-    pose.child_frame = "base";
-    pose.x = keys[i].T_world_base.x();
-    pose.y = keys[i].T_world_base.y();
-    pose.theta = keys[i].T_world_base.theta();
-    copy_matrix(keys[i].covariance, pose.covariance);
-    pose.flags = pose2d_t::FLAG_KEY_POSE;
-    bus_.publish(config_.trajectory_channel, pose);
-  }
-  if (state_) state_->persist(backend_);
 }
 
 void BackendNode::report_counters() {
@@ -248,6 +283,8 @@ void BackendNode::report_counters() {
   counters_("scan_bytes_per_key_pose", backend_.scans().bytes_per_key_pose());
   counters_("key_poses_messages", static_cast<double>(messages_));
   counters_("key_poses_message_max_bytes", static_cast<double>(max_message_bytes_));
+  counters_("graph_requests", static_cast<double>(graph_requests_));
+  counters_("graph_answers", static_cast<double>(graph_answers_));
   if (!state_) return;
   const BackendStateCounters& s = state_->counters();
   counters_("state_snapshots", static_cast<double>(s.snapshots));

@@ -62,7 +62,7 @@ struct MapperConfig {
   double range_max_m = 6.0;    // [m] farther returns are dropped (seed 000: 6 m)
   Footprint footprint;
   std::string rig_file = "configs/rig.yaml";  // laser_profile extrinsic T_base_laser
-  std::string output_dir = "out/mapper";      // exports: cloud.ply, map.bt, map.ot
+  std::string output_dir = "out/mapper";      // exports: cloud.ply, map.bt, map.ot, map_colour.ot
   std::string pose_channel;  // "": DENSE_SEGMENTS from the densifier; else pose2d_t stream
   std::string annotations_channel = "ANNOTATIONS";  // annotations_t colours; "": none
   int poses_per_segment = 40;                       // segment length when reading a pose2d_t stream

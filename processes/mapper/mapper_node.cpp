@@ -234,6 +234,11 @@ bool MapperNode::export_all(std::string* error) {
     if (error) *error = "cannot write the OctoMap into " + dir.string();
     return false;
   }
+  const auto coloured = coloured_octree(mapper_, colours_, &voxel_colours_);
+  if (!coloured->write((dir / "map_colour.ot.tmp").string()) || !replace("map_colour.ot")) {
+    if (error) *error = "cannot write " + (dir / "map_colour.ot").string();
+    return false;
+  }
   return true;
 }
 
@@ -276,6 +281,8 @@ void MapperNode::report_counters() {
   counters_("profiles", s.profiles);
   counters_("annotated_key_poses", static_cast<double>(colours_.size()));
   counters_("annotation_level_changes", level_changes_);
+  counters_("voxels_coloured", static_cast<double>(voxel_colours_.voxels));
+  counters_("voxels_annotated", static_cast<double>(voxel_colours_.annotated));
   counters_("profiles_pending", s.pending);
   counters_("profiles_rejected", s.rejected);
   counters_("profiles_dropped", s.dropped);

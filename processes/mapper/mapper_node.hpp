@@ -5,7 +5,8 @@
 // a revision that arrives late cannot undo a newer one) or, with `pose_channel` set, as a plain
 // pose2d_t stream (e.g. POSE_GROUND_TRUTH) cut into segments of `poses_per_segment` poses that
 // never move. The annotator's colours (annotations_t on ANNOTATIONS) are kept per key pose, newest
-// first, and given to every point at export (cloud.ply's red, green, blue and level).
+// first, and given to every point at export (cloud.ply's red, green, blue and level) and to every
+// occupied voxel (map_colour.ot, a ColorOcTree: the worst level of its points, voxel_colours.hpp).
 // Out, besides the exports: a decimated preview of every profile placed for the first time
 // (cloud_preview_t on CLOUD_PREVIEW, preview.hpp) for the operator's viewer, published from the
 // process's own thread (publish_preview()).
@@ -47,6 +48,7 @@
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
+#include "voxel_colours.hpp"
 
 namespace traverse::mapper {
 
@@ -65,8 +67,8 @@ class MapperNode {
 
   // Waits until everything received so far is in the map (moves applied).
   void flush();
-  // Writes cloud.ply, map.bt and map.ot into the output folder (after a flush); false (and why)
-  // on failure.
+  // Writes cloud.ply, map.bt, map.ot and map_colour.ot into the output folder (after a flush);
+  // false (and why) on failure.
   bool export_all(std::string* error);
   // At shutdown: closes the last segment of a pose2d_t stream, applies everything, stops the
   // worker.
@@ -118,8 +120,9 @@ class MapperNode {
   // Handler side (LCM thread).
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first
   double segments_stale_ = 0;
-  TrajectorySegment open_;  // pose2d_t stream: poses since the last cut
-  PointColours colours_;    // the annotations, by key pose (this thread only)
+  TrajectorySegment open_;           // pose2d_t stream: poses since the last cut
+  PointColours colours_;             // the annotations, by key pose (this thread only)
+  VoxelColourCounts voxel_colours_;  // of the last export (this thread only)
   double level_changes_ = 0;
   int64_t next_key_id_ = 0;
   std::unique_ptr<MapperStateStore> state_;  // written on this thread

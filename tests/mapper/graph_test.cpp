@@ -3,6 +3,7 @@
 // and a re-optimisation republishes only the moved segments and moves the mapper's points.
 #include <gtest/gtest.h>
 #include <octomap/AbstractOcTree.h>
+#include <octomap/ColorOcTree.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <numbers>
+#include <tuple>
 
 #include "channels.hpp"
 #include "densifier_node.hpp"
@@ -23,6 +25,12 @@ namespace {
 constexpr int64_t kT0 = 1'700'000'000'000'000;
 constexpr int64_t kPoseDt = 20'000;  // [us] 50 Hz frontend
 constexpr int kKeyEvery = 15;
+
+struct KeyLess {
+  bool operator()(const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) const {
+    return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+  }
+};
 
 // Parameter: the mapper on its own worker thread (live) or inline (replay).
 class GraphTest : public ::testing::TestWithParam<bool> {
@@ -244,7 +252,8 @@ TEST_P(GraphTest, ExportsReadBackThroughThePlyReaderAndOctoMapsOwnTool) {
 }
 
 // The annotator's colours in the export: each point takes the level and colour of the key pose
-// nearest in time, and the newest annotation of a key pose wins (a loop closure recolours).
+// nearest in time, and the newest annotation of a key pose wins (a loop closure recolours); each
+// voxel of the coloured OctoMap takes the worst level of its points.
 TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
   drive(100, true);
   auto annotate = [&](const std::vector<int>& ids, int8_t level, uint8_t red, uint8_t green) {
@@ -282,7 +291,31 @@ TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
   }
   EXPECT_GT(red, 0);
   EXPECT_GT(green, red);
+  // map_colour.ot: each occupied voxel in the colour of the worst level of the PLY points in it.
+  std::unique_ptr<octomap::AbstractOcTree> read(
+      octomap::AbstractOcTree::read((out_dir_ / "map_colour.ot").string()));
+  const auto* tree = dynamic_cast<const octomap::ColorOcTree*>(read.get());
+  ASSERT_NE(tree, nullptr);
+  std::map<octomap::OcTreeKey, mapper::PointColour, KeyLess> worst;
+  for (const mapper::CloudPoint& p : *cloud) {
+    const octomap::OcTreeKey key = tree->coordToKey(p.p_world.x(), p.p_world.y(), p.p_world.z());
+    auto [it, inserted] = worst.try_emplace(key, p.colour);
+    if (!inserted && p.colour.level > it->second.level) it->second = p.colour;
+  }
+  int red_voxels = 0;
+  for (const auto& [key, colour] : worst) {
+    const octomap::ColorOcTreeNode* node = tree->search(key);
+    ASSERT_NE(node, nullptr);
+    ASSERT_TRUE(tree->isNodeOccupied(node));
+    EXPECT_EQ(node->getColor(),
+              octomap::ColorOcTreeNode::Color(colour.rgb[0], colour.rgb[1], colour.rgb[2]));
+    red_voxels += colour.level == 4;
+  }
+  EXPECT_GT(red_voxels, 0);
+  EXPECT_EQ(worst.size(), mapper_->mapper().occupied_voxels());
   mapper_->report_counters();
+  EXPECT_EQ(mapper_counters_.at("voxels_coloured"), static_cast<double>(worst.size()));
+  EXPECT_EQ(mapper_counters_.at("voxels_annotated"), static_cast<double>(worst.size()));
   EXPECT_EQ(mapper_counters_.at("annotation_level_changes"), 2.0);
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 7.0);
 }
