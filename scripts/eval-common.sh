@@ -50,6 +50,11 @@ estimate_channel() {
   esac
 }
 
+# check_tag NAME: a --tag goes into a folder name: a plain name only.
+check_tag() {
+  [[ -z $1 || $1 =~ ^[A-Za-z0-9._-]+$ ]] || die "--tag must be a plain name, not '$1'"
+}
+
 # "frontend,backend" -> "frontend+backend"; no stage -> "none" (the reference against itself).
 stages_tag() {
   [[ -z $1 ]] && echo none || echo "${1//,/+}"

@@ -50,7 +50,7 @@ while (($#)); do
 done
 command -v python3 >/dev/null || die "python3 is needed to read the JSON (scripts/setup.sh)"
 
-[[ -z $tag || $tag =~ ^[A-Za-z0-9._-]+$ ]] || die "--tag must be a plain name, not '$tag'"
+check_tag "$tag"
 if [[ -n $all ]]; then
   [[ -z $what && -z $relations && -z $tag && ${#CONFIG_SETS[@]} -eq 0 ]] || usage
   exec python3 "$ROOT/scripts/kummerle_table.py" "$0" ${OFFLINE:+--offline} --speed "$speed"

@@ -76,7 +76,7 @@ done
 [[ $seed =~ ^[0-9]+$ ]] || die "--seed must be a non-negative integer, not '$seed'"
 [[ $profile == ideal || $profile == realistic ]] || die "--profile must be ideal or realistic, not '$profile'"
 [[ -z $duration || $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || die "--duration must be seconds, not '$duration'"
-[[ -z $tag || $tag =~ ^[A-Za-z0-9._-]+$ ]] || die "--tag must be a plain name, not '$tag'"
+check_tag "$tag"
 [[ -z $DESKEW_OFF ]] || CONFIG_SETS+=(frontend.deskew.enabled=false)
 
 route_file="$ROOT/configs/routes/$route.yaml"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "config.hpp"
 #include "scan_message.hpp"
@@ -72,7 +73,7 @@ void BackendNode::on_graph_request(const graph_request_t&) {
     return;
   }
   std::vector<int> all(n_keys);
-  for (std::size_t i = 0; i < n_keys; ++i) all[i] = static_cast<int>(i);
+  std::iota(all.begin(), all.end(), 0);
   publish_edges(0, edges_published_, last_update_.optimisation, channels::kPoseGraphEdgesFull);
   publish_key_poses(all, n_keys, last_update_, channels::kKeyPosesFull);
   last_answer_utime_ = newest;

@@ -1,9 +1,8 @@
 // traverse-mapper: places every point of the tilted profile scanner with the corrected trajectory
 // at its own time, into an OctoMap and a full-density cloud that follow loop closures. Exports
 // cloud.ply, map.bt, map.ot and map_colour.ot into the output folder on SIGUSR1 and at shutdown.
-// With
-// --state-dir DIR it keeps what it took there and, started again on the same DIR (restarted after
-// a crash, or a session resumed), rebuilds its map from it and goes on (mapper_state.hpp).
+// With --state-dir DIR it keeps what it took there and, started again on the same DIR (restarted
+// after a crash, or a session resumed), rebuilds its map from it and goes on (mapper_state.hpp).
 #include <spdlog/spdlog.h>
 
 #include <atomic>

@@ -3,14 +3,6 @@
 #include <unordered_map>
 
 namespace traverse::mapper {
-namespace {
-
-uint64_t pack(const octomap::OcTreeKey& k) {
-  return static_cast<uint64_t>(k[0]) | static_cast<uint64_t>(k[1]) << 16 |
-         static_cast<uint64_t>(k[2]) << 32;
-}
-
-}  // namespace
 
 std::unique_ptr<octomap::ColorOcTree> coloured_octree(const Mapper& mapper,
                                                       const PointColours& colours,
@@ -18,12 +10,12 @@ std::unique_ptr<octomap::ColorOcTree> coloured_octree(const Mapper& mapper,
   const octomap::OcTree& tree = mapper.octree();
   // Worst level per voxel: levels are legend indices, best first, so the worst is the largest;
   // an unannotated point (-1) loses to any annotated one.
-  std::unordered_map<uint64_t, PointColour> worst;
+  std::unordered_map<octomap::OcTreeKey, PointColour, octomap::OcTreeKey::KeyHash> worst;
   mapper.for_each_point([&](const CloudPoint& p) {
     octomap::OcTreeKey key;
     if (!tree.coordToKeyChecked(p.p_world.x(), p.p_world.y(), p.p_world.z(), key)) return;
     const PointColour c = colours.at(p.utime);
-    auto [it, inserted] = worst.try_emplace(pack(key), c);
+    auto [it, inserted] = worst.try_emplace(key, c);
     if (!inserted && c.level > it->second.level) it->second = c;
   });
   auto out = std::make_unique<octomap::ColorOcTree>(tree.getResolution());
@@ -34,7 +26,7 @@ std::unique_ptr<octomap::ColorOcTree> coloured_octree(const Mapper& mapper,
     const octomap::OcTreeKey key = it.getKey();
     out->setNodeValue(key, it->getLogOdds(), true);
     if (!tree.isNodeOccupied(*it)) continue;
-    const auto w = worst.find(pack(key));
+    const auto w = worst.find(key);
     const PointColour c = w == worst.end() ? PointColour{} : w->second;
     out->setNodeColor(key, c.rgb[0], c.rgb[1], c.rgb[2]);
     ++n.voxels;

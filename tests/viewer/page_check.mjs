@@ -52,10 +52,7 @@ async function look(page) {
     if (!s.legend || !window.viewer) return out;
     window.viewer.fit();
     window.viewer.keyPoints.visible = false;
-    window.viewer.render();
-    const gl = window.viewer.renderer.getContext();
-    const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight, px = new Uint8Array(w * h * 4);
-    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const { px } = window.viewer.pixels();
     window.viewer.keyPoints.visible = true;
     window.viewer.render();
     for (const l of s.legend.levels) {
@@ -140,10 +137,7 @@ async function keysDrawn(page) {
     const s = window.viewerState;
     if (!s.legend || !window.viewer) return [];
     window.viewer.fit();
-    window.viewer.render();
-    const gl = window.viewer.renderer.getContext();
-    const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight, px = new Uint8Array(w * h * 4);
-    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const { w, h, px } = window.viewer.pixels();
     return window.viewer.keysOnScreen().map((k) => {
       const rgb = s.legend.levels[k.level].rgb;
       const i = (k.sy * w + k.sx) * 4;

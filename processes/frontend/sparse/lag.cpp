@@ -56,8 +56,8 @@ double SparseLag::score(const Held& held, const Pose2& T, const Pose2& T_next,
                 step_prior_cost(step_prior(config_, T), T_next);
   if (recent_steps_m_.size() >= kRecentSteps / 2) {
     // A step odometry measured long is not long for the log: its limit grows with it.
+    const double usual = recent_steps_m_.percentile(90);
     const auto limit = [&](const std::optional<Pose2>& odometry) {
-      const double usual = recent_steps_m_.percentile(90);
       return kLongStepFactor * (odometry ? std::max(usual, odometry->translation().norm()) : usual);
     };
     const std::pair<double, double> steps[] = {

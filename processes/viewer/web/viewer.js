@@ -510,9 +510,18 @@ function keysOnScreen() {
   });
 }
 
+// The whole view drawn now, as RGBA bytes of the drawing buffer (rows from the bottom).
+function pixels() {
+  renderer.render(scene, camera);
+  const gl = renderer.getContext();
+  const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight, px = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  return { w, h, px };
+}
+
 // For tests: draw now (the pixels are then read in the same task) and the objects drawn.
 window.viewer = { renderer, scene, render: () => renderer.render(scene, camera), cloud, keyPoints, fit,
-  keysOnScreen };
+  keysOnScreen, pixels };
 
 setView('top');
 connect();
