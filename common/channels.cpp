@@ -13,4 +13,6 @@ std::string status_channel(const std::string& process_name) {
   return "STATUS_" + upper;
 }
 
+std::string full_channel(const std::string& channel) { return channel + "_FULL"; }
+
 }  // namespace traverse::channels

@@ -32,9 +32,15 @@ inline const std::string kFrontendControl =
     "FRONTEND_CONTROL";  // frontend_control_t, which frontend runs (operator's requests)
 inline const std::string kCloudPreview =
     "CLOUD_PREVIEW";  // cloud_preview_t, the mapper's decimated points for screens
+inline const std::string kResendRequest =
+    "RESEND_REQUEST";  // resend_request_t, a late listener asks for the whole state of channels
 
 // LCM's udpm provider sends one message here when an instance starts: not part of any run.
 inline const std::string kLcmSelfTest = "LCM_SELF_TEST";
+
+// Where the whole state behind an incremental channel is published once more when a late
+// listener asks for it (resend_request_t on RESEND_REQUEST): <channel>_FULL, as KEY_POSES_FULL.
+std::string full_channel(const std::string& channel);
 
 // Every process publishes process_status_t once a second on STATUS_<NAME> (name upper-cased).
 std::string status_channel(const std::string& process_name);

@@ -3,19 +3,27 @@
 #
 # What the operator's viewer costs the live graph (issue 26): the same simulated run (ROUTE,
 # default office-s2, seed 1, the first --duration seconds, default 60) goes through the whole graph
-# live (scripts/run-graph.sh, configs/deploy/pipeline.yaml): without the viewer ("none"), with
-# the viewer and no browser ("viewer"), with the viewer and one headless chromium keeping its page
-# open for the whole run ("browser"; tests/viewer/page_check.mjs --watch; the browser runs on this
-# machine, so its software WebGL drawing competes with the graph for the same cores, which a
-# tablet's would not), and with the viewer and a chromium page that only reads its WebSocket
-# ("client": what a browser on another device costs this machine). For each run it prints every
-# process's CPU time [s], chromium's, and the
-# monitor's counts of messages missed, dropped, out of order or rejected and its verdict, and the
-# viewer's own figures; JSON last. --runs picks some of none,viewer,client,browser,no-preview (the last:
-# without the viewer and with the mapper's preview off, preview.channel "", to see what the
-# preview costs the mapper). --repeat N runs the list N times over (alternating, so that the load
-# of the machine falls on every kind of run alike); the figures are given per run and as min /
-# median / max per kind.
+# live, at the sensors' pace (scripts/run-graph.sh, configs/deploy/pipeline.yaml), as:
+#   none        without the viewer;
+#   viewer      with the viewer and no browser;
+#   browser     with the viewer and one headless chromium drawing its page for the whole run on
+#               this machine, next to the graph (tests/viewer/page_check.mjs --watch);
+#   remote      with the viewer bound by its config to the address of a second "device": a network
+#               namespace joined to this one by a veth pair (limited to 30 Mbit/s each way, a
+#               Wi-Fi-like rate) with chromium drawing the page in it; that chromium still runs on this
+#               machine's cores, at nice 19, standing for a tablet whose processor the graph does
+#               not share as near as one machine can (its CPU time is reported all the same);
+#   client      with the viewer and a chromium page that only reads its WebSocket here;
+#   no-preview  without the viewer and with the mapper's preview off (preview.channel "").
+# For each run it prints every process's CPU time [s], chromium's, the monitor's counts of
+# messages missed, dropped, out of order or rejected and its verdict, how the graph kept up with
+# the sensors (frontend poses per scan, the frontend's, backend's and annotator's lags behind the
+# scans [s], from the recorded run: scripts/viewer_cost.py) and the machine's load average and
+# busy share during the run (the machine may be shared); JSON last. --runs picks some of
+# none,viewer,browser,remote,client,no-preview (default none,viewer,browser,remote). --repeat N
+# runs the list N times over (alternating, so that the load of the machine falls on every kind of
+# run alike); the figures are given per run and as min / median / max per kind. The remote run
+# makes a network namespace and a veth pair (root; removed at the end).
 # Outputs under out/viewer-cost/.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -32,7 +40,7 @@ die() {
   exit 1
 }
 
-route=office-s2 duration=60 seed=1 runs=none,viewer,client,browser repeat=1
+route=office-s2 duration=60 seed=1 runs=none,viewer,browser,remote repeat=1
 while (($#)); do
   case "$1" in
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
@@ -69,6 +77,33 @@ fi
 "$PY" "$ROOT/scripts/conf.py" set "$out/deploy.yaml" processes.mapper.config \
   "$out/mapper-no-preview.yaml" >"$out/deploy-no-preview.yaml"
 
+# The second device for the remote runs: a namespace joined by a veth pair, the viewer bound to
+# this side's address.
+tablet="" here_ip=10.203.0.1 tablet_ip=10.203.0.2
+cleanup() { [[ -z $tablet ]] || ip netns del "$tablet" 2>/dev/null || true; }
+trap cleanup EXIT
+if [[ ,$runs, == *,remote,* ]]; then
+  tablet="trvvc-$$-tablet" link="trvvc$$"
+  ip netns add "$tablet" || die "cannot make a network namespace (root needed) for the remote runs"
+  ip -n "$tablet" link set lo up
+  ip link add "$link" type veth peer name eth0 netns "$tablet"
+  ip addr add "$here_ip/30" dev "$link" && ip link set "$link" up
+  ip -n "$tablet" addr add "$tablet_ip/30" dev eth0 && ip -n "$tablet" link set eth0 up
+  # A Wi-Fi-like rate both ways (a token bucket: tc's netem, which would add delay, is a kernel
+  # module not every machine has).
+  tc qdisc add dev "$link" root tbf rate 30mbit burst 32kbit latency 50ms
+  ip netns exec "$tablet" tc qdisc add dev eth0 root tbf rate 30mbit burst 32kbit latency 50ms
+  "$PY" "$ROOT/scripts/conf.py" set "$ROOT/configs/viewer.yaml" address "$here_ip" \
+    >"$out/viewer-remote.yaml"
+  "$PY" "$ROOT/scripts/conf.py" set "$out/deploy.yaml" processes.viewer.config \
+    "$out/viewer-remote.yaml" >"$out/deploy-remote.yaml"
+fi
+
+# The machine's 1-min load average and busy share of all its cores (every process, this run's
+# included) between two calls.
+cpu_ticks() { awk '/^cpu /{print $2+$3+$4+$7+$8, $5+$6; exit}' /proc/stat; }
+load_1min() { cut -d' ' -f1 /proc/loadavg; }
+
 names=()
 for ((i = 1; i <= repeat; ++i)); do
 for run in ${runs//,/ }; do
@@ -79,15 +114,21 @@ for run in ${runs//,/ }; do
     none) stages=all ;;
     no-preview) stages=all deploy="$out/deploy-no-preview.yaml" ;;
     viewer | client | browser) stages=all,viewer ;;
-    *) die "unknown run '$run' (none, viewer, client, browser, no-preview)" ;;
+    remote) stages=all,viewer deploy="$out/deploy-remote.yaml" ;;
+    *) die "unknown run '$run' (none, viewer, browser, remote, client, no-preview)" ;;
   esac
   dir="$out/$name"
   rm -rf "$dir"
   echo "viewer-cost: run '$name' (stages $stages)" >&2
+  load0=$(load_1min) ticks0=$(cpu_ticks)
+  # The recording keeps what the lags are measured on (the profile scans, IMU and previews are
+  # left out: a few hundred MB a run).
   TRAVERSE_BIN_DIR="$BIN" "$ROOT/scripts/run-graph.sh" --deploy "$deploy" --log "$sim" \
-    --out "$dir" --stages "$stages" >"$out/$name.out" 2>&1 &
+    --out "$dir" --stages "$stages" \
+    --record-without 'SCAN_PROFILE|IMU|ODOMETRY|POSE_GROUND_TRUTH.*|CLOUD_PREVIEW.*|POSE_DENSE|DENSE_SEGMENTS.*' \
+    >"$out/$name.out" 2>&1 &
   graph=$!
-  if [[ $run == browser || $run == client ]]; then
+  if [[ $run == browser || $run == client || $run == remote ]]; then
     url=""
     for _ in $(seq 1 300); do
       url="$(grep -o 'open http://[0-9.:]*/' "$dir/viewer.log" 2>/dev/null | head -n 1 | cut -c 6-)" || true
@@ -95,66 +136,19 @@ for run in ${runs//,/ }; do
       sleep 0.2
     done
     [[ -n $url ]] || die "the viewer never said where it serves (see $dir/viewer.log)"
-    node "$page_check" --url "$url" --screenshot "$out/$name.png" --watch "$duration" \
-      $([[ $run == client ]] && echo --no-draw) \
-      >"$out/$name-page.json" 2>"$out/$name-page.log" || true
+    browser_cmd=(node "$page_check" --url "$url" --screenshot "$out/$name.png" --watch "$duration")
+    [[ $run == client ]] && browser_cmd+=(--no-draw)
+    [[ $run == remote ]] && browser_cmd=(ip netns exec "$tablet" nice -n 19 "${browser_cmd[@]}")
+    "${browser_cmd[@]}" >"$out/$name-page.json" 2>"$out/$name-page.log" || true
   fi
   wait "$graph" || echo "viewer-cost: run-graph for '$name' exited $? (see $out/$name.out)" >&2
+  read -r busy1 idle1 <<<"$(cpu_ticks)"
+  read -r busy0 idle0 <<<"$ticks0"
+  "$PY" -c 'import json, sys; b = int(sys.argv[3]) - int(sys.argv[4]); i = int(sys.argv[5]) - int(sys.argv[6])
+print(json.dumps({"load_1min_start": float(sys.argv[1]), "load_1min_end": float(sys.argv[2]),
+                  "busy_share": round(b / max(b + i, 1), 3), "cores": int(sys.argv[7])}))' \
+    "$load0" "$(load_1min)" "$busy1" "$busy0" "$idle1" "$idle0" "$(nproc)" >"$out/$name-load.json"
 done
 done
 
-"$PY" - "$out" "$(IFS=,; echo "${names[*]}")" "$duration" <<'PY'
-import json, os, statistics, sys
-out, runs, duration = sys.argv[1], sys.argv[2].split(","), float(sys.argv[3])
-result = {"duration_s": duration, "runs": {}}
-for run in runs:
-    path = os.path.join(out, run, "monitor.json")
-    try:
-        mon = json.load(open(path))
-    except (OSError, ValueError):
-        result["runs"][run] = None
-        continue
-    procs = mon.get("processes", {})
-    cpu = {name: round(p.get("cpu_s", 0.0), 2) for name, p in procs.items()}
-    lost = {k: sum(p.get(k, 0) for n, p in procs.items() if n != "monitor")
-            for k in ("missed", "queue_dropped", "out_of_order", "rejected", "decode_failures")}
-    graph = [n for n in procs if n not in ("monitor", "viewer")]
-    row = {"cpu_s": cpu, "graph_cpu_s": round(sum(cpu[n] for n in graph), 2),
-           "max_status_gap_s": round(max((p.get("max_status_gap_s") or 0.0) for p in procs.values()), 2),
-           "problems": mon.get("problems", []), **lost}
-    page = os.path.join(out, run + "-page.json")
-    if os.path.exists(page):
-        try:
-            row["page"] = json.loads(open(page).read().strip().splitlines()[-1]).get("watched")
-        except (ValueError, IndexError):
-            row["page"] = None
-    result["runs"][run] = row
-    print(f"{run:8s} graph CPU {row['graph_cpu_s']:7.2f} s (viewer {cpu.get('viewer', 0):.2f} s, "
-          f"mapper {cpu.get('mapper', 0):.2f} s); missed {lost['missed']}, dropped "
-          f"{lost['queue_dropped']}, out of order {lost['out_of_order']}, rejected "
-          f"{lost['rejected']}; longest status gap {row['max_status_gap_s']} s; "
-          f"verdict problems: {len(row['problems'])}", file=sys.stderr)
-# Per kind of run (name without its repeat number): min / median / max.
-kinds = {}
-for run, row in result["runs"].items():
-    if row:
-        kinds.setdefault(run.rsplit("-", 1)[0] if run[-1].isdigit() else run, []).append(row)
-result["kinds"] = {}
-for kind, rows in kinds.items():
-    spread = lambda xs: [min(xs), statistics.median(xs), max(xs)]
-    result["kinds"][kind] = {
-        "runs": len(rows),
-        "graph_cpu_s": spread([r["graph_cpu_s"] for r in rows]),
-        "viewer_cpu_s": spread([r["cpu_s"].get("viewer", 0.0) for r in rows]),
-        "mapper_cpu_s": spread([r["cpu_s"].get("mapper", 0.0) for r in rows]),
-        "missed": spread([r["missed"] for r in rows]),
-        "chromium_cpu_s": spread([(r.get("page") or {}).get("chromium_cpu_s", 0.0) for r in rows]),
-        "runs_with_problems": sum(1 for r in rows if r["problems"]),
-    }
-    k = result["kinds"][kind]
-    print(f"{kind:10s} x{len(rows)}: graph CPU {k['graph_cpu_s']} s, viewer {k['viewer_cpu_s']} s, "
-          f"chromium {k['chromium_cpu_s']} s, missed {k['missed']}, runs with verdict problems "
-          f"{k['runs_with_problems']}",
-          file=sys.stderr)
-print(json.dumps(result))
-PY
+"$PY" "$ROOT/scripts/viewer_cost.py" "$out" "$(IFS=,; echo "${names[*]}")" "$duration"

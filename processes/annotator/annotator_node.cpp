@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "config.hpp"
+#include "resend.hpp"
 #include "traverse/graph_request_t.hpp"
 
 namespace traverse::annotator {
@@ -95,6 +96,15 @@ AnnotatorNode::AnnotatorNode(Bus& bus, const AnnotatorNodeConfig& config, Counte
       config_.edges_channel, [this](const pose_graph_edges_t& m) { on_edges(m); }, true);
   bus_.subscribe<key_poses_t>(
       config_.key_poses_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
+  // A late listener's answer: every annotation, as at the end of data but not final.
+  answer_resend_requests(bus_, config_.annotations_channel, [this](const std::string&) {
+    const std::vector<Annotation> all = all_annotations();
+    if (!all.empty()) {
+      publish(all, annotations_t::REASON_NEW, 0,
+              channels::full_channel(config_.annotations_channel));
+    }
+    ++resend_answers_;
+  });
   if (config_.graph_request_channel.empty()) return;
   // The backend's answers to a graph request: the whole graph, read like an update.
   bus_.subscribe<pose_graph_edges_t>(
@@ -143,7 +153,9 @@ void AnnotatorNode::on_key_poses(const key_poses_t& msg) {
   const int8_t reason =
       closure_pending_ ? annotations_t::REASON_LOOP_CLOSURE : annotations_t::REASON_NEW;
   closure_pending_ = false;
-  if (!changed.empty()) publish(changed, reason, annotator_.last_level_changes());
+  if (!changed.empty()) {
+    publish(changed, reason, annotator_.last_level_changes(), config_.annotations_channel);
+  }
   // Something was missed (started late, or a message lost): ask for the whole graph.
   if (annotator_.key_poses_held() < static_cast<std::size_t>(graph_key_poses_) ||
       annotator_.counters().edges < graph_edges_) {
@@ -152,19 +164,24 @@ void AnnotatorNode::on_key_poses(const key_poses_t& msg) {
 }
 
 void AnnotatorNode::publish(const std::vector<Annotation>& annotations, int8_t reason,
-                            int32_t changed_level) {
+                            int32_t changed_level, const std::string& channel) {
   for (annotations_t& m :
        pack_annotations(annotator_, annotations, utime_, optimisation_, reason, loop_closures_,
                         changed_level, config_.max_keys_per_message)) {
-    bus_.publish(config_.annotations_channel, m);
+    bus_.publish(channel, m);
     ++messages_;
   }
 }
 
-void AnnotatorNode::finish() {
+std::vector<Annotation> AnnotatorNode::all_annotations() const {
   std::vector<Annotation> all;
   for (const auto& [id, a] : annotator_.annotations()) all.push_back(a);
-  if (!all.empty()) publish(all, annotations_t::REASON_FINAL, 0);
+  return all;
+}
+
+void AnnotatorNode::finish() {
+  const std::vector<Annotation> all = all_annotations();
+  if (!all.empty()) publish(all, annotations_t::REASON_FINAL, 0, config_.annotations_channel);
 }
 
 void AnnotatorNode::report_counters() {
@@ -184,6 +201,7 @@ void AnnotatorNode::report_counters() {
   counters_("update_total_s", update_s_total_);
   counters_("update_max_s", update_s_max_);
   counters_("graph_requests", graph_requests_);
+  counters_("resend_answers", resend_answers_);
 }
 
 }  // namespace traverse::annotator

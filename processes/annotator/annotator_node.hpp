@@ -10,7 +10,9 @@
 // local bound. It asks for the whole graph (graph_request_t on graph_request_channel) when it
 // starts and after every optimisation that leaves it holding fewer key poses or edges than the
 // backend says the graph has; the backend answers on KEY_POSES_FULL and POSE_GRAPH_EDGES_FULL
-// (backend_node.hpp), which this node reads like the incremental channels.
+// (backend_node.hpp), which this node reads like the incremental channels. In turn, a listener
+// that started after the annotator (the viewer, the mapper) asks for every annotation
+// (resend_request_t naming ANNOTATIONS) and gets them on ANNOTATIONS_FULL.
 #pragma once
 
 #include <functional>
@@ -70,7 +72,9 @@ class AnnotatorNode {
  private:
   void on_edges(const pose_graph_edges_t& msg);
   void on_key_poses(const key_poses_t& msg);
-  void publish(const std::vector<Annotation>& annotations, int8_t reason, int32_t changed_level);
+  void publish(const std::vector<Annotation>& annotations, int8_t reason, int32_t changed_level,
+               const std::string& channel);
+  std::vector<Annotation> all_annotations() const;
   // Asks the backend for its whole graph (at most once per optimisation heard).
   void request_graph();
 
@@ -84,7 +88,7 @@ class AnnotatorNode {
   bool closure_pending_ = false;
   int32_t graph_key_poses_ = 0, graph_edges_ = 0;  // the backend's graph, as its messages say
   int32_t requested_at_ = -1;                      // optimisation of the last graph request
-  double graph_requests_ = 0;
+  double graph_requests_ = 0, resend_answers_ = 0;
   double messages_ = 0, updates_ = 0, update_s_total_ = 0, update_s_max_ = 0;
 };
 

@@ -234,6 +234,16 @@ std::vector<Segment> Densifier::settle() {
   return out;
 }
 
+std::vector<Segment> Densifier::sent_segments() const {
+  std::vector<Segment> out;
+  for (const auto& [utime, seg] : segments_) {
+    if (seg.revision < 0) continue;
+    out.push_back(
+        {keys_.at(utime).key.id, keys_.at(seg.utime_last).key.id, seg.revision, seg.poses});
+  }
+  return out;
+}
+
 void Densifier::refresh_segment(std::map<int64_t, KeyState>::iterator it, std::vector<Segment>& out,
                                 bool exact) {
   if (it == keys_.end()) return;

@@ -139,6 +139,9 @@ class Densifier {
   // End of data: every segment that differs at all from its last sent revision (moves below
   // the republish thresholds add up to at most them), so the final trajectory is exact.
   std::vector<Segment> settle();
+  // Every segment as last returned (its newest revision), in time order: what a listener that
+  // started late has missed.
+  std::vector<Segment> sent_segments() const;
 
   // Corrected pose at `utime`: bent inside closed segments, and moved rigidly with the nearest
   // key pose's correction before the first and after the last closed key pose.

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "channels.hpp"
+#include "resend.hpp"
 
 namespace traverse::densifier {
 
@@ -60,6 +61,10 @@ DensifierNode::DensifierNode(Bus& bus, const DensifierConfig& config, CounterSin
   bus_.subscribe<pose2d_t>(channels::kPoseFrontend, [this](const pose2d_t& m) { on_frontend(m); });
   bus_.subscribe<key_poses_t>(
       config_.key_pose_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
+  answer_resend_requests(bus_, channels::kDenseSegments, [this](const std::string&) {
+    publish(densifier_.sent_segments(), channels::full_channel(channels::kDenseSegments));
+    ++resend_answers_;
+  });
 }
 
 void DensifierNode::on_frontend(const pose2d_t& msg) {
@@ -70,23 +75,23 @@ void DensifierNode::on_frontend(const pose2d_t& msg) {
     return;
   }
   newest_frontend_utime_ = std::max(newest_frontend_utime_, msg.utime);
-  publish(closed);
+  publish(closed, channels::kDenseSegments);
 }
 
 void DensifierNode::on_key_poses(const key_poses_t& msg) {
   optimisation_ = std::max(optimisation_, msg.optimisation);
   std::vector<KeyPose> keys;
   for (const key_pose_t& k : msg.poses) keys.push_back({k.id, k.utime, Pose2(k.x, k.y, k.theta)});
-  publish(densifier_.update_key_poses(keys));
+  publish(densifier_.update_key_poses(keys), channels::kDenseSegments);
 }
 
-void DensifierNode::publish(const std::vector<Segment>& segments) {
+void DensifierNode::publish(const std::vector<Segment>& segments, const std::string& channel) {
   if (segments.empty()) return;
   for (dense_segments_t& msg : pack_segments(segments, config_.parent_frame, child_frame_,
                                              optimisation_, config_.max_message_bytes)) {
     msg.utime = newest_frontend_utime_;
     if (msg.getEncodedSize() > config_.max_message_bytes) ++oversize_messages_;
-    bus_.publish(channels::kDenseSegments, msg);
+    bus_.publish(channel, msg);
     ++segment_messages_;
     segments_published_ += msg.n_segments;
   }
@@ -108,7 +113,7 @@ void DensifierNode::publish(const std::vector<Segment>& segments) {
   }
 }
 
-void DensifierNode::finish() { publish(densifier_.settle()); }
+void DensifierNode::finish() { publish(densifier_.settle(), channels::kDenseSegments); }
 
 void DensifierNode::report_counters() {
   if (!counters_) return;
@@ -120,6 +125,7 @@ void DensifierNode::report_counters() {
   counters_("segments_moved", static_cast<double>(densifier_.segments_moved()));
   counters_("spikes_replaced", static_cast<double>(densifier_.spikes_replaced()));
   counters_("dense_rejected", dense_rejected_);
+  counters_("resend_answers", resend_answers_);
 }
 
 }  // namespace traverse::densifier

@@ -5,7 +5,9 @@
 // Out: every pose of a newly closed segment once on POSE_DENSE (pose2d_t, as the trajectory
 // grows), and the new or moved segments whole on DENSE_SEGMENTS (dense_segments_t), packed many to
 // a message of at most `max_message_bytes`: after a loop closure hundreds of segments move at
-// once, and one small datagram each overflowed the listeners' receive buffers.
+// once, and one small datagram each overflowed the listeners' receive buffers. A listener that
+// started late (the viewer) asks for every segment (resend_request_t naming DENSE_SEGMENTS), and
+// gets them on DENSE_SEGMENTS_FULL, the newest revision of each.
 #pragma once
 
 #include <functional>
@@ -37,7 +39,8 @@ class DensifierNode {
  private:
   void on_frontend(const pose2d_t& msg);
   void on_key_poses(const key_poses_t& msg);
-  void publish(const std::vector<Segment>& segments);
+  // Segments on `channel` (DENSE_SEGMENTS, or its _FULL answer); the new poses on POSE_DENSE.
+  void publish(const std::vector<Segment>& segments, const std::string& channel);
 
   Bus& bus_;
   DensifierConfig config_;
@@ -48,7 +51,7 @@ class DensifierNode {
   int64_t newest_frontend_utime_ = 0;  // [us] utime of DENSE_SEGMENTS: never goes backwards
   int32_t optimisation_ = 0;           // newest backend optimisation seen on KEY_POSES
   double segments_published_ = 0, segment_messages_ = 0, oversize_messages_ = 0;
-  double dense_rejected_ = 0;
+  double dense_rejected_ = 0, resend_answers_ = 0;
 };
 
 }  // namespace traverse::densifier

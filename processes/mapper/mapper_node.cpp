@@ -5,6 +5,7 @@
 
 #include "channels.hpp"
 #include "ply.hpp"
+#include "resend.hpp"
 #include "scan_message.hpp"
 #include "segment_message.hpp"
 
@@ -36,6 +37,18 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
     // Parts of one update share a utime.
     bus.subscribe<annotations_t>(
         config_.annotations_channel, [this](const annotations_t& m) { on_annotations(m); }, true);
+    // An annotator already running has annotations this node has not heard.
+    bus.subscribe<annotations_t>(
+        channels::full_channel(config_.annotations_channel),
+        [this](const annotations_t& m) { on_annotations(m); }, true);
+    request_resend(bus, "mapper", {config_.annotations_channel});
+  }
+  if (preview_) {
+    answer_resend_requests(bus, config_.preview.channel, [this](const std::string&) {
+      resend_next_ = 0;  // from the start, paced by publish_preview()
+      ++resend_answers_;
+    });
+    resend_next_ = preview_sent_.size();
   }
   if (worker_thread) worker_ = std::thread([this] { run_worker(); });
 }
@@ -263,6 +276,26 @@ void MapperNode::publish_preview() {
     m.n_profiles = static_cast<int32_t>(m.profiles.size());
     bus_.publish(config_.preview.channel, m);
     ++preview_messages_;
+    const bool resend_done = resend_next_ == preview_sent_.size();
+    preview_sent_.push_back(std::move(m));
+    if (resend_done) resend_next_ = preview_sent_.size();  // a late viewer just got this one
+  }
+  // A late viewer's answer, at most kResendBytes per kResendWindow: a whole route's preview is
+  // tens of MB, and on LCM's multicast every process of the graph receives every message, so at
+  // once it would overflow the sockets of the busiest (the frontend's) as well as the viewer's.
+  constexpr std::size_t kResendBytes = 64 << 10;
+  constexpr auto kResendWindow = std::chrono::milliseconds(100);
+  const auto now = std::chrono::steady_clock::now();
+  if (now - resend_window_ >= kResendWindow) {
+    resend_window_ = now;
+    resend_window_bytes_ = 0;
+  }
+  const std::string full = channels::full_channel(config_.preview.channel);
+  while (resend_next_ < preview_sent_.size() && resend_window_bytes_ < kResendBytes) {
+    cloud_preview_t& m = preview_sent_[resend_next_++];
+    resend_window_bytes_ += static_cast<std::size_t>(m.getEncodedSize());
+    bus_.publish(full, m);
+    ++resend_messages_;
   }
 }
 
@@ -312,6 +345,8 @@ void MapperNode::report_counters() {
   if (preview_) {
     counters_("preview_points", static_cast<double>(preview_->points()));
     counters_("preview_messages", preview_messages_);
+    counters_("resend_answers", resend_answers_);
+    counters_("resend_messages", resend_messages_);
   }
 }
 

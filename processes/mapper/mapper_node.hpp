@@ -11,6 +11,13 @@
 // (cloud_preview_t on CLOUD_PREVIEW, preview.hpp) for the operator's viewer, published from the
 // process's own thread (publish_preview()).
 //
+// Late listeners: every preview message sent is kept (about 6 bytes a point), and a viewer that
+// starts after the mapper asks for them (resend_request_t naming CLOUD_PREVIEW) and gets them
+// again on CLOUD_PREVIEW_FULL, paced by publish_preview() (640 KB/s) so as not to overflow the
+// sockets of the viewer or of the other processes, which receive every multicast message. In
+// turn the node asks the annotator for every annotation when it starts (ANNOTATIONS_FULL), so a
+// mapper started after the annotator colours its points at once, not grey until the end of data.
+//
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
 // whole route). The bus already queues what arrives meanwhile (bus.hpp), so nothing is lost
@@ -116,6 +123,13 @@ class MapperNode {
   Mapper mapper_;                          // touched only by the worker (or inline)
   std::unique_ptr<CloudPreview> preview_;  // filled by the worker, published by publish_preview
   double preview_messages_ = 0;
+  // Every preview message sent, for a late viewer; the next to send again (none when at the end),
+  // and how many bytes went out in the current pacing window.
+  std::vector<cloud_preview_t> preview_sent_;
+  std::size_t resend_next_ = 0;
+  std::chrono::steady_clock::time_point resend_window_;
+  std::size_t resend_window_bytes_ = 0;
+  double resend_answers_ = 0, resend_messages_ = 0;
   CounterSink counters_;
   // Handler side (LCM thread).
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first

@@ -203,4 +203,6 @@ Frame encode_guidance(const Guidance& g) {
                {"loop_target", g.loop_target ? target(*g.loop_target) : json(nullptr)}});
 }
 
+Frame encode_view(double voxel_m) { return text({{"type", "view"}, {"voxel_m", voxel_m}}); }
+
 }  // namespace traverse::viewer

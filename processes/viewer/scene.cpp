@@ -12,6 +12,15 @@ void Scene::add_profile(int64_t utime, std::vector<std::array<int16_t, 3>> p_bas
     ++counters_.profiles_rejected;
     return;
   }
+  // A copy of points held (a late viewer's answer overlapping what came live, or answered twice):
+  // a profile's preview points lie in distinct cells, so a part whose first point is held is one.
+  if (auto held = by_utime_.find(utime); held != by_utime_.end()) {
+    const auto& pts = profiles_[held->second].p_base_mm;
+    if (std::find(pts.begin(), pts.end(), p_base_mm.front()) != pts.end()) {
+      ++counters_.profiles_repeated;
+      return;
+    }
+  }
   const int64_t room = config_.max_points - points_;
   if (room <= 0) {
     ++counters_.profiles_rejected;

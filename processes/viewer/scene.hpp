@@ -81,6 +81,7 @@ struct Changes {
 // Inputs that could not be used, counted (the status reports them).
 struct SceneCounters {
   int64_t profiles_rejected = 0;     // empty, or over max_points
+  int64_t profiles_repeated = 0;     // points already held, sent again (dropped)
   int64_t points_dropped = 0;        // beyond max_points
   int64_t segments_rejected = 0;     // fewer than two poses, or times not increasing
   int64_t segments_stale = 0;        // an older revision than the one held
@@ -97,7 +98,8 @@ class Scene {
  public:
   explicit Scene(const SceneConfig& config);
 
-  // Preview points of the profile at `utime` (appended when that profile is already held).
+  // Preview points of the profile at `utime` (appended when that profile is already held, unless
+  // they are a copy of points held).
   void add_profile(int64_t utime, std::vector<std::array<int16_t, 3>> p_base_mm);
   // A densifier segment (revision: newer ones replace older ones); places the profiles it covers.
   void set_segment(const mapper::TrajectorySegment& segment, int32_t revision);

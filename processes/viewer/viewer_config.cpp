@@ -20,6 +20,7 @@ std::optional<std::string> validate(const ViewerConfig& c) {
   // A snapshot of a large cloud must fit in a queue, or a browser could never catch up.
   check.in_range("client_queue_bytes", c.client_queue_bytes, int64_t{1} << 20, int64_t{1} << 32);
   check.in_range("max_points", c.max_points, 1, 100'000'000);
+  check.in_range("voxel_m", c.voxel_m, 0.01, 10.0);
   return check.problem();
 }
 

@@ -23,6 +23,12 @@ struct ViewerConfig {
   std::string annotations_channel = channels::kAnnotations;  // annotations_t, the colours
   std::string pose_channel = channels::kPoseFrontend;        // pose2d_t, the newest pose
   std::string status_prefix = "STATUS_";                     // process_status_t of every process
+  // At start, ask the mapper, densifier and annotator for what they published before (answered on
+  // <channel>_FULL): a viewer started late shows the whole run. false: only what comes from now.
+  bool ask_for_state = true;
+  // [m] edge of the voxels the page draws (its "voxels" toggle): the OctoMap's nodes eight leaves
+  // (of the mapper's 2 cm) wide, each in the colour of the worst level among its points.
+  double voxel_m = 0.16;
 
   double update_period_s = 0.2;     // [s] how often changes go to the browsers
   double trajectory_step_m = 0.05;  // [m] drawn trajectory: poses at least this far apart
@@ -41,6 +47,8 @@ struct ViewerConfig {
     v("annotations_channel", annotations_channel);
     v("pose_channel", pose_channel);
     v("status_prefix", status_prefix);
+    v("ask_for_state", ask_for_state);
+    v("voxel_m", voxel_m);
     v("update_period_s", update_period_s);
     v("trajectory_step_m", trajectory_step_m);
     v("pose_history_s", pose_history_s);

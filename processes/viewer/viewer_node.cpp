@@ -2,8 +2,10 @@
 
 #include <chrono>
 
+#include "channels.hpp"
 #include "guidance.hpp"
 #include "message_checks.hpp"
+#include "resend.hpp"
 #include "segment_message.hpp"
 #include "traverse/process_status_t.hpp"
 
@@ -23,6 +25,22 @@ ViewerNode::ViewerNode(Bus& bus, const ViewerConfig& config, WebServer* server,
       config_.segments_channel, [this](const dense_segments_t& m) { on_segments(m); }, true);
   bus_.subscribe<annotations_t>(
       config_.annotations_channel, [this](const annotations_t& m) { on_annotations(m); }, true);
+  // What the graph published before this viewer started: asked for once, answered on the _FULL
+  // channels (resend.hpp) and read like the live ones.
+  bus_.subscribe<cloud_preview_t>(
+      channels::full_channel(config_.preview_channel),
+      [this](const cloud_preview_t& m) { on_preview(m); }, true);
+  bus_.subscribe<dense_segments_t>(
+      channels::full_channel(config_.segments_channel),
+      [this](const dense_segments_t& m) { on_segments(m); }, true);
+  bus_.subscribe<annotations_t>(
+      channels::full_channel(config_.annotations_channel),
+      [this](const annotations_t& m) { on_annotations(m); }, true);
+  if (config_.ask_for_state) {
+    request_resend(
+        bus_, "viewer",
+        {config_.preview_channel, config_.segments_channel, config_.annotations_channel});
+  }
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
   // Every process's status: one subscription for all, decoded here with the bus's checks (a typed
   // subscription would count the processes' interleaved sequence numbers as losses).
@@ -108,6 +126,7 @@ void ViewerNode::update(int64_t now_utime) {
   if (server_->snapshot_wanted()) {
     std::vector<Frame> all = encode_snapshot(scene_);
     all.push_back(status);
+    all.push_back(encode_view(config_.voxel_m));
     if (guidance) all.push_back(*guidance);
     server_->send_snapshot(all);
   }
@@ -124,6 +143,7 @@ void ViewerNode::report_counters() {
   counters_("key_poses_annotated", static_cast<double>(scene_.annotations().size()));
   counters_("trajectory_segments", static_cast<double>(scene_.polylines().size()));
   counters_(config_.preview_channel + "/rejected", static_cast<double>(c.profiles_rejected));
+  counters_("profiles_repeated", static_cast<double>(c.profiles_repeated));
   counters_("points_dropped", static_cast<double>(c.points_dropped));
   counters_(config_.segments_channel + "/rejected", static_cast<double>(c.segments_rejected));
   counters_("segments_stale", static_cast<double>(c.segments_stale));

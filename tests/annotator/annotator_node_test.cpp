@@ -7,9 +7,11 @@
 
 #include <Eigen/Eigenvalues>
 #include <map>
+#include <set>
 
 #include "backend_node.hpp"
 #include "drive_feed.hpp"
+#include "resend.hpp"
 #include "traverse/key_poses_t.hpp"
 
 namespace traverse::annotator {
@@ -34,10 +36,20 @@ class AnnotatorNodeTest : public ::testing::Test {
     bus_.subscribe<pose_graph_edges_t>(
         channels::kPoseGraphEdges, [this](const pose_graph_edges_t& m) { edges_.push_back(m); },
         true);
+    bus_.subscribe<annotations_t>(
+        channels::full_channel(channels::kAnnotations),
+        [this](const annotations_t& m) { full_.push_back(m); }, true);
     const backend::test::Drive d = backend::test::drive_ellipse(18.0);
     for (std::size_t k = 0; k < d.utimes.size(); ++k) {
       backend::test::publish_drive_step(bus_, d, k);
       handle_all();
+    }
+    if (ask_) {  // a listener that started late, before the end of data
+      const std::size_t before = messages_.size();
+      request_resend(bus_, "test", {channels::kAnnotations});
+      handle_all();
+      annotated_when_asked_ = annotator.annotator().annotations().size();
+      answer_on_incremental_ = messages_.size() - before;
     }
     backend.finish();
     handle_all();
@@ -62,7 +74,27 @@ class AnnotatorNodeTest : public ::testing::Test {
   std::vector<Eigen::Matrix3d> backend_marginals_;
   std::vector<Pose2> backend_poses_;
   std::size_t backend_edges_ = 0, closures_ = 0;
+  bool ask_ = false;
+  std::vector<annotations_t> full_;  // the answer to a late listener (ANNOTATIONS_FULL)
+  std::size_t annotated_when_asked_ = 0, answer_on_incremental_ = 0;
 };
+
+// A listener that starts late asks for every annotation and gets them all on ANNOTATIONS_FULL,
+// with the legend, and nothing more on ANNOTATIONS.
+TEST_F(AnnotatorNodeTest, ALateListenerGetsEveryAnnotation) {
+  ask_ = true;
+  run(AnnotatorNodeConfig{});
+  ASSERT_GT(annotated_when_asked_, 10u);
+  std::set<int64_t> ids;
+  for (const annotations_t& m : full_) {
+    EXPECT_EQ(m.n_levels, 5);
+    EXPECT_EQ(m.parts, static_cast<int32_t>(full_.size()));
+    for (const key_annotation_t& k : m.keys) ids.insert(k.id);
+  }
+  EXPECT_EQ(ids.size(), annotated_when_asked_);
+  EXPECT_EQ(answer_on_incremental_, 0u);
+  EXPECT_EQ(counters_.at("resend_answers"), 1.0);
+}
 
 TEST_F(AnnotatorNodeTest, RebuildsTheBackendsGraphAndCoversEveryKeyPose) {
   AnnotatorNodeConfig config;

@@ -17,6 +17,7 @@
 #include "densifier_node.hpp"
 #include "mapper_node.hpp"
 #include "ply.hpp"
+#include "resend.hpp"
 #include "test_profile.hpp"
 
 namespace traverse {
@@ -318,6 +319,65 @@ TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
   EXPECT_EQ(mapper_counters_.at("voxels_annotated"), static_cast<double>(worst.size()));
   EXPECT_EQ(mapper_counters_.at("annotation_level_changes"), 2.0);
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 7.0);
+}
+
+// A listener that starts late asks once for what came before (resend.hpp): the densifier answers
+// with the newest revision of every segment on DENSE_SEGMENTS_FULL, the mapper with every preview
+// message it sent on CLOUD_PREVIEW_FULL, and neither answer reaches the incremental channels. The
+// mapper, in turn, takes the annotator's answer on ANNOTATIONS_FULL like ANNOTATIONS.
+TEST_P(GraphTest, ALateListenerGetsEverySegmentAndPreviewProfileAgain) {
+  std::vector<cloud_preview_t> preview, preview_again;
+  std::vector<dense_segment_t> segments_again;
+  bus_.subscribe<cloud_preview_t>(channels::kCloudPreview,
+                                  [&](const cloud_preview_t& m) { preview.push_back(m); });
+  bus_.subscribe<cloud_preview_t>(channels::full_channel(channels::kCloudPreview),
+                                  [&](const cloud_preview_t& m) { preview_again.push_back(m); });
+  bus_.subscribe<dense_segments_t>(
+      channels::full_channel(channels::kDenseSegments), [&](const dense_segments_t& m) {
+        segments_again.insert(segments_again.end(), m.segments.begin(), m.segments.end());
+      });
+  drive(100, true);
+  send_keys({5, 6}, 0.05);  // segments 4 and 5 move: revision 1
+  handle_all();
+  mapper_->flush();
+  mapper_->publish_preview();
+  handle_all();
+  ASSERT_GT(preview.size(), 0u);
+  const std::size_t segments_sent = segments_.size();
+  EXPECT_TRUE(preview_again.empty() && segments_again.empty());  // nobody asked yet
+
+  request_resend(bus_, "test", {channels::kDenseSegments, channels::kCloudPreview});
+  handle_all();
+  mapper_->publish_preview();  // the mapper answers from its own thread, paced
+  handle_all();
+  EXPECT_EQ(segments_.size(), segments_sent);  // nothing more on DENSE_SEGMENTS
+  ASSERT_EQ(segments_again.size(), 6u);
+  for (std::size_t i = 0; i < segments_again.size(); ++i) {
+    EXPECT_EQ(segments_again[i].key_id_first, static_cast<int64_t>(i));
+    EXPECT_EQ(segments_again[i].revision, i >= 4 ? 1 : 0);
+  }
+  EXPECT_NEAR(segments_again[5].y.front(), 0.05, 1e-12);
+  ASSERT_EQ(preview_again.size(), preview.size());
+  for (std::size_t i = 0; i < preview.size(); ++i) {
+    ASSERT_EQ(preview_again[i].n_profiles, preview[i].n_profiles);
+    EXPECT_EQ(preview_again[i].profiles[0].utime, preview[i].profiles[0].utime);
+    EXPECT_EQ(preview_again[i].profiles[0].x_mm, preview[i].profiles[0].x_mm);
+  }
+
+  annotations_t a{};
+  a.utime = kT0;
+  a.parts = 1;
+  a.keys.resize(2);
+  a.keys[0].id = 0;
+  a.keys[0].utime = kT0;
+  a.keys[1].id = 1;
+  a.keys[1].utime = kT0 + kKeyEvery * kPoseDt;
+  a.n_keys = 2;
+  bus_.publish(channels::full_channel(channels::kAnnotations), a);
+  handle_all();
+  mapper_->report_counters();
+  EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 2.0);
+  EXPECT_EQ(mapper_counters_.at("resend_answers"), 1.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),

@@ -35,10 +35,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
-echo "simulating $ROUTE (seed $SEED, first $DURATION s)"
-(cd "$ROOT" && "$BIN/traverse-sim" --config configs/sim.yaml --world configs/worlds/office.yaml \
-  --route "configs/routes/$ROUTE.yaml" --seed "$SEED" --duration "$DURATION" \
-  --out "$work/sim.lcmlog" >"$work/sim.out" 2>&1) || { tail "$work/sim.out"; exit 1; }
+simulate_office "$ROOT" "$BIN" "$ROUTE" "$SEED" "$DURATION" "$work/sim.lcmlog"
 
 # The pipeline as deployed, the viewer on a free port (tests run side by side).
 /usr/bin/python3 "$ROOT/scripts/conf.py" set "$ROOT/configs/deploy/pipeline.yaml" \

@@ -1,10 +1,13 @@
 // Opens traverse-viewer's page in Debian's headless chromium (driven by playwright-core, which
 // downloads no browser) and checks what a person would see: a cloud, the legend of the standard,
 // and points in at least two accuracy colours, read from the page's state and from the pixels of
-// its WebGL canvas. Saves a screenshot.
+// its WebGL canvas; then, with the page's "voxels" ticked, the same cloud as coloured voxels (in
+// at least two accuracy colours, on the canvas too). Saves a screenshot of each (the voxels' beside
+// the first, "-voxels" added to its name).
 //
 //   node page_check.mjs --url http://127.0.0.1:PORT/ --screenshot FILE [--timeout S]
 //                       [--min-points N] [--cut-feed] [--watch S [--no-draw]] [--closure N]
+//                       [--compare URL]
 //
 // Two pages are opened side by side: the page as served, which must pass, and the same page with
 // its WebSocket cut (answered by a stand-in that never sends anything), which must fail: the check
@@ -18,7 +21,10 @@
 // the key poses on screen while a run with loop closures is fed to the viewer, and passes when at
 // least N key poses were seen drawn in one level's colour and later, after a better level arrived,
 // in that better level's (different) colour: the colours change live where a closure shrank the
-// bounds.
+// bounds. --compare URL (a viewer there from the start) checks the page of --url (a viewer started
+// late) as above and passes when it also shows what the page at URL shows, read at the same
+// moment: as many points and profiles (at least 97 %), key poses (at most 3 fewer), trajectory
+// poses (at least 97 %), and the same share of points per level (within 3 points of percentage).
 import { chromium } from 'playwright-core';
 import { mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -49,24 +55,40 @@ async function look(page) {
       levelCounts: s.levelCounts, annotations: s.annotations, trajectoryPoses: s.trajectoryPoses,
       processes: s.processes.length, pixels: {},
     };
-    if (!s.legend || !window.viewer) return out;
-    window.viewer.fit();
-    window.viewer.keyPoints.visible = false;
-    const { px } = window.viewer.pixels();
-    window.viewer.keyPoints.visible = true;
-    window.viewer.render();
-    for (const l of s.legend.levels) {
-      const key = l.rgb.join(',');
-      if (key in out.pixels) continue;  // levels may share a colour (all better than the best)
-      let n = 0;
-      for (let i = 0; i < px.length; i += 4) {
-        if (Math.abs(px[i] - l.rgb[0]) <= 2 && Math.abs(px[i + 1] - l.rgb[1]) <= 2 &&
-            Math.abs(px[i + 2] - l.rgb[2]) <= 2) ++n;
-      }
-      out.pixels[key] = n;
-    }
+    if (s.legend && window.viewer) out.pixels = window.viewer.legendPixels();
     return out;
   });
+}
+
+// The page with "voxels" ticked: how many voxels it draws per level, and the canvas's pixels per
+// legend colour with the key poses hidden (the points are hidden by the toggle itself).
+async function lookVoxels(page, timeoutS) {
+  await page.check('#voxels');
+  const deadline = Date.now() + timeoutS * 1000;
+  let v;
+  for (;;) {
+    v = await page.evaluate(() => {
+      const s = window.viewerState;
+      const out = { voxels: s.voxels, levels: s.voxelLevelCounts, pixels: {}, colours: {} };
+      if (!s.legend || !s.voxels) return out;
+      out.pixels = window.viewer.legendPixels();
+      out.colours = Object.fromEntries(s.legend.levels.map((l) => [l.name, l.rgb.join(',')]));
+      return out;
+    });
+    if (v.voxels > 0 || Date.now() > deadline) break;
+    await new Promise((r) => setTimeout(r, 500));
+  }
+  return v;
+}
+
+function voxelVerdict(v) {
+  if (!v.voxels) return 'no voxels drawn';
+  const coloured = new Set(Object.entries(v.levels)
+    .filter(([name, n]) => name !== 'none' && n > 0).map(([name]) => v.colours[name]));
+  if (coloured.size < 2) return `voxels in ${coloured.size} accuracy colour(s) only`;
+  const drawn = Object.entries(v.pixels).filter(([, n]) => n >= 20);
+  if (drawn.length < 2) return `voxel pixels in ${drawn.length} legend colour(s) only: ${JSON.stringify(v.pixels)}`;
+  return null;
 }
 
 // Why what the page shows is not enough, or null when it is.
@@ -83,6 +105,52 @@ function verdict(v) {
   const drawn = Object.entries(v.pixels).filter(([, n]) => n >= 20);
   if (drawn.length < 2) return `pixels in ${drawn.length} legend colour(s) only: ${JSON.stringify(v.pixels)}`;
   return null;
+}
+
+// Why the late page differs from the early one, or null when it shows the same.
+function sameAs(late, early) {
+  const short = (what, a, b, share) => (a < share * b ? `${what}: ${a} late, ${b} early` : null);
+  const why = short('points', late.points, early.points, 0.97) ||
+    short('profiles', late.profiles, early.profiles, 0.97) ||
+    short('trajectory poses', late.trajectoryPoses, early.trajectoryPoses, 0.97) ||
+    (late.annotations < early.annotations - 3
+      ? `key poses: ${late.annotations} late, ${early.annotations} early` : null);
+  if (why) return why;
+  const share = (v, name) => (v.levelCounts[name] || 0) / Math.max(v.points, 1);
+  for (const name of new Set([...Object.keys(late.levelCounts), ...Object.keys(early.levelCounts)])) {
+    const a = share(late, name), b = share(early, name);
+    if (Math.abs(a - b) > 0.03) {
+      return `share of points at ${name}: ${(100 * a).toFixed(1)} % late, ${(100 * b).toFixed(1)} % early`;
+    }
+  }
+  return null;
+}
+
+async function compare(context, result) {
+  const late = await context.newPage(), early = await context.newPage();
+  const errors = [];
+  late.on('pageerror', (e) => errors.push(String(e)));
+  await late.goto(args.url);
+  await early.goto(args.compare);
+  const deadline = Date.now() + Number(args.timeout) * 1000;
+  let seen, why;
+  // What both pages hold, read at once (the graph runs on, and both viewers hear it).
+  const counts = (page) => page.evaluate(() => {
+    const s = window.viewerState;
+    return { points: s.points, profiles: s.profiles, trajectoryPoses: s.trajectoryPoses,
+      annotations: s.annotations, levelCounts: s.levelCounts };
+  });
+  for (;;) {
+    const [a, b] = await Promise.all([counts(late), counts(early)]);
+    seen = { late: { ...(await look(late)), ...a }, early: b };
+    why = verdict(seen.late) || sameAs(seen.late, seen.early);
+    if (!why || Date.now() > deadline) break;
+    await new Promise((r) => setTimeout(r, 1000));
+  }
+  await late.screenshot({ path: args.screenshot });
+  Object.assign(result, { late_page: seen.late, early_page: seen.early, problem: why,
+    page_errors: errors, screenshot: args.screenshot });
+  return !why && errors.length === 0;
 }
 
 // CPU time [s] of every process whose command line names `dir` (chromium's, by its profile).
@@ -213,6 +281,12 @@ async function check(context, result) {
   await served.screenshot({ path: args.screenshot });
   result.page = seen;
   result.page_problem = why;
+  if (!why && served !== cut) {
+    result.voxels = await lookVoxels(served, 10);
+    result.voxels_problem = voxelVerdict(result.voxels);
+    await served.screenshot({ path: args.screenshot.replace(/(\.png)?$/, '-voxels.png') });
+    why = result.voxels_problem;
+  }
   result.page_errors = errors;
   if (served !== cut) {
     result.cut_page = await look(cut);
@@ -229,6 +303,8 @@ try {
   if (args.watch) {
     result.watched = await watch(context, Number(args.watch));
     ok = result.watched.connected;
+  } else if (args.compare) {
+    ok = await compare(context, result);
   } else if (args.closure) {
     ok = await closure(context, result, Number(args.closure));
   } else {

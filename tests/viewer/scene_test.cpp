@@ -83,6 +83,20 @@ TEST(Scene, MovesProfilesOnlyWithANewerRevision) {
   EXPECT_TRUE(scene.take_changes().moved_profiles.empty());
 }
 
+TEST(Scene, KeepsTheRestOfASplitProfileButNotACopy) {
+  Scene scene({});
+  scene.set_segment(straight(0, 0.0, 1.0, 0.0), 0);
+  scene.add_profile(kT0 + 500'000, {{1, 0, 0}, {2, 0, 0}});
+  scene.add_profile(kT0 + 500'000, {{3, 0, 0}});  // the rest of the profile, in a second message
+  EXPECT_EQ(scene.points(), 3);
+  scene.add_profile(kT0 + 500'000, {{1, 0, 0}, {2, 0, 0}});  // sent again to a late viewer
+  scene.add_profile(kT0 + 500'000, {{3, 0, 0}});
+  EXPECT_EQ(scene.points(), 3);
+  EXPECT_EQ(scene.profiles().size(), 1u);
+  EXPECT_EQ(scene.profiles()[0].p_base_mm.size(), 3u);
+  EXPECT_EQ(scene.counters().profiles_repeated, 2);
+}
+
 TEST(Scene, RejectsWhatCannotBeUsed) {
   Scene scene({.trajectory_step_m = 0.05, .pose_history_s = 60, .max_points = 3});
   mapper::TrajectorySegment bad = straight(0, 0.0, 1.0, 0.0);

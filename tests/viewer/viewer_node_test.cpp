@@ -17,6 +17,7 @@
 #include "channels.hpp"
 #include "process.hpp"
 #include "traverse/process_status_t.hpp"
+#include "traverse/resend_request_t.hpp"
 
 namespace traverse::viewer {
 namespace {
@@ -137,6 +138,46 @@ TEST_F(ViewerNodeTest, FillsTheSceneAndCountsWhatItDrops) {
   EXPECT_EQ(counters_.at("STATUS_*/rejected"), 1);
   EXPECT_EQ(counters_.at("statuses"), 1);
   EXPECT_EQ(counters_.at("points"), 4);
+}
+
+TEST_F(ViewerNodeTest, AsksForWhatCameBeforeAndTakesTheAnswersOnce) {
+  std::vector<std::vector<std::string>> asked;
+  bus_.subscribe<resend_request_t>(channels::kResendRequest,
+                                   [&](const resend_request_t& m) { asked.push_back(m.channels); });
+  ViewerNode node(bus_, ViewerConfig{}, nullptr,
+                  [this](const std::string& k, double v) { counters_[k] = v; });
+  handle_all();
+  ASSERT_EQ(asked.size(), 1u);  // one request naming the three channels
+  EXPECT_EQ(asked[0], (std::vector<std::string>{channels::kCloudPreview, channels::kDenseSegments,
+                                                channels::kAnnotations}));
+  // A profile heard live, then the answers, which hold it again and one from before.
+  Bus& pub = bus_;
+  auto live = preview({kT0 + 300'000});
+  pub.publish(channels::kCloudPreview, live);
+  auto before = preview({kT0 + 200'000, kT0 + 300'000});
+  pub.publish(channels::full_channel(channels::kCloudPreview), before);
+  pub.publish(channels::full_channel(channels::kDenseSegments), seg0_);
+  auto a = annotations();
+  pub.publish(channels::full_channel(channels::kAnnotations), a);
+  handle_all();
+  node.report_counters();
+  EXPECT_EQ(node.scene().profiles().size(), 2u);
+  EXPECT_EQ(node.scene().points(), 4);  // the repeated profile's points once
+  EXPECT_EQ(counters_.at("profiles_repeated"), 1);
+  EXPECT_TRUE(node.scene().profiles()[0].placed);
+  EXPECT_EQ(node.scene().annotations().size(), 3u);
+  EXPECT_EQ(node.scene().polylines().size(), 1u);
+}
+
+TEST_F(ViewerNodeTest, DoesNotAskWhenToldNotTo) {
+  int asked = 0;
+  bus_.subscribe<resend_request_t>(channels::kResendRequest,
+                                   [&](const resend_request_t&) { ++asked; });
+  ViewerConfig config;
+  config.ask_for_state = false;
+  ViewerNode node(bus_, config, nullptr);
+  handle_all();
+  EXPECT_EQ(asked, 0);
 }
 
 TEST_F(ViewerNodeTest, ABrowserGetsTheSceneThenTheChanges) {

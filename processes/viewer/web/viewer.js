@@ -7,6 +7,7 @@
 // a person at the browser's console.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { Voxels } from './voxels.js';
 
 // Colours as the legend gives them (sRGB bytes), drawn as they are: no colour-space conversion,
 // so a legend colour is the colour on the screen.
@@ -16,7 +17,7 @@ const GREY = [0.5, 0.5, 0.5];
 const state = {
   connected: false, frames: 0, bytes: 0, resets: 0, points: 0, profiles: 0, moves: 0,
   legend: null, annotations: 0, levelCounts: {}, trajectoryPoses: 0, pose: null, guidance: null,
-  processes: [], bottom: null, lastFrameAt: 0,
+  processes: [], bottom: null, lastFrameAt: 0, voxels: 0, voxelLevelCounts: {},
 };
 window.viewerState = state;
 
@@ -70,6 +71,7 @@ class Cloud {
     this.object = new THREE.Points(this.geometry, this.material);
     this.object.frustumCulled = false;
     this.profiles = new Map();  // index -> {utime, offset, n, base, x, y, theta, level}
+    this.version = 0;  // +1 whenever a point moves or changes colour (the voxels follow)
     this.grow(1 << 16);
   }
   grow(capacity) {
@@ -87,6 +89,7 @@ class Cloud {
     this.geometry.setDrawRange(0, this.count);
   }
   clear() {
+    ++this.version;
     state.levelCounts = {};
     this.profiles.clear();
     this.count = 0;
@@ -122,6 +125,7 @@ class Cloud {
     const attribute = this.geometry.attributes.position;
     attribute.addUpdateRange(p.offset * 3, p.n * 3);
     attribute.needsUpdate = true;
+    ++this.version;
     dirty = true;
   }
   paint(p, level) {
@@ -134,6 +138,7 @@ class Cloud {
     const attribute = this.geometry.attributes.color;
     attribute.addUpdateRange(p.offset * 3, p.n * 3);
     attribute.needsUpdate = true;
+    ++this.version;
     dirty = true;
   }
   recolour() {
@@ -182,6 +187,10 @@ function colourOf(level) {
   const rgb = state.legend.levels[level].rgb;
   return [rgb[0] / 255, rgb[1] / 255, rgb[2] / 255];
 }
+
+// The same points as coloured voxels, drawn instead of the points when "voxels" is ticked.
+const voxels = new Voxels(scene, cloud, colourOf);
+let voxelsBuiltFor = -1;  // cloud.version they show
 
 // Key poses, drawn larger than the cloud's points in their level's colour.
 const keyPoints = new THREE.Points(new THREE.BufferGeometry(),
@@ -285,6 +294,9 @@ function onText(msg) {
     case 'guidance':
       state.guidance = msg;
       showGuidance();
+      break;
+    case 'view':
+      voxels.setSize(msg.voxel_m);
       break;
   }
   dirty = true;
@@ -473,6 +485,12 @@ $('view-top').onclick = () => setView('top');
 $('fit').onclick = fit;
 $('view-3d').onclick = () => setView('3d');
 $('follow').onchange = () => follow();
+$('voxels').onchange = () => {
+  const on = $('voxels').checked;
+  voxels.show(on);
+  cloud.object.visible = !on;
+  dirty = true;
+};
 $('bottom').onchange = () => { state.bottom = +$('bottom').value; showGuidance(); };
 window.addEventListener('resize', resize);
 
@@ -488,6 +506,14 @@ function frame() {
   if (trajectoryChanged) {
     trajectoryChanged = false;
     redrawTrajectory();
+    dirty = true;
+  }
+  if (cloud.version !== voxelsBuiltFor) voxels.stale = true;
+  if (voxels.update(performance.now())) {
+    voxelsBuiltFor = cloud.version;
+    state.voxels = voxels.count;
+    state.voxelLevelCounts = Object.fromEntries(Object.entries(voxels.levelCounts)
+      .map(([level, n]) => [levelName(+level), n]));
     dirty = true;
   }
   if (dirty) {
@@ -519,9 +545,32 @@ function pixels() {
   return { w, h, px };
 }
 
+// The whole map from above, key poses hidden: pixels per legend colour ("r,g,b" -> count; levels
+// may share a colour), for tests and for a person at the console.
+function legendPixels() {
+  const out = {};
+  if (!state.legend) return out;
+  fit();
+  keyPoints.visible = false;
+  const { px } = pixels();
+  keyPoints.visible = true;
+  renderer.render(scene, camera);
+  for (const l of state.legend.levels) {
+    const key = l.rgb.join(',');
+    if (key in out) continue;
+    let n = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      if (Math.abs(px[i] - l.rgb[0]) <= 2 && Math.abs(px[i + 1] - l.rgb[1]) <= 2 &&
+          Math.abs(px[i + 2] - l.rgb[2]) <= 2) ++n;
+    }
+    out[key] = n;
+  }
+  return out;
+}
+
 // For tests: draw now (the pixels are then read in the same task) and the objects drawn.
 window.viewer = { renderer, scene, render: () => renderer.render(scene, camera), cloud, keyPoints, fit,
-  keysOnScreen, pixels };
+  keysOnScreen, pixels, legendPixels, voxels };
 
 setView('top');
 connect();
