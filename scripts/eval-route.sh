@@ -2,11 +2,13 @@
 # scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--profile P] [--speed S] [--offline]
 #                       [--duration S] [--deskew-off] [--set PROCESS.KEY=VALUE ...] [--tag NAME]
 #                       [--record-outputs-only] [--verdict-warns] [--wheel-encoders]
+#                       [--sim-set KEY=VALUE ...]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim, configs/sim.yaml and configs/rig.yaml (cached as
-# out/cache/ROUTE-seedN-PROFILE[-noprofiles]-HASH.lcmlog, HASH of the route, its world, sim.yaml
-# and rig.yaml; without the mapper among the stages the tilted scanner's profiles are left out;
+# out/cache/ROUTE-seedN-PROFILE[-wheels][-simH][-noprofiles]-HASH.lcmlog, HASH of the route, its
+# world, sim.yaml and rig.yaml, -simH the --sim-set config's; without the mapper among the stages
+# the tilted scanner's profiles are left out;
 # regenerated when the sim program is newer), runs the named stages of the graph on it
 # (scripts/run-graph.sh, configs/deploy/pipeline.yaml), and evaluates the last stage's trajectory
 # against the ground truth with traverse-evaluator. With no stage the ground truth is evaluated
@@ -28,6 +30,9 @@
 #   --set P.K=V    run process P (of configs/deploy/pipeline.yaml) with key K of its config set to
 #                  V, e.g. --set backend.backend.link.resolution_m=0.01 (repeatable; the changed
 #                  configs are written to the output folder); give the run a --tag
+#   --sim-set K=V  simulate with key K of configs/sim.yaml set to V, e.g. --sim-set
+#                  effects.clocks.enabled=false (repeatable; one realistic effect at a time; the
+#                  changed config is cached beside the log and named by its hash); give a --tag
 #   --tag NAME     outputs under ROUTE-seedN-PROFILE-STAGES-NAME
 #   --record-outputs-only  run.lcmlog without the sensor channels (scans, IMU, odometry, 3D truth):
 #                  what the graph published, the statuses and the 2D ground truth, all the
@@ -43,6 +48,8 @@ DESKEW_OFF=""
 RECORD_OUTPUTS_ONLY=""
 VERDICT_WARNS=""
 WHEEL_ENCODERS=""
+SIM_SETS=()
+sim_tag=""  # -simHASH with --sim-set: the changed config's log and outputs apart from the others
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -62,6 +69,7 @@ while (($#)); do
     --duration) duration="${2:?--duration needs seconds}"; shift 2 ;;
     --deskew-off) DESKEW_OFF=1; shift ;;
     --set) CONFIG_SETS+=("${2:?--set needs PROCESS.KEY=VALUE}"); shift 2 ;;
+    --sim-set) SIM_SETS+=("${2:?--sim-set needs KEY=VALUE}"); shift 2 ;;
     --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
     --record-outputs-only) RECORD_OUTPUTS_ONLY=1; shift ;;
     --verdict-warns) VERDICT_WARNS=1; shift ;;
@@ -97,8 +105,25 @@ need_programs traverse-sim traverse-evaluator
 sim_config="$ROOT/configs/sim.yaml"
 rig_config="$ROOT/configs/rig.yaml"
 [[ -f $sim_config && -f $rig_config ]] || die "configs/sim.yaml or configs/rig.yaml missing"
+mkdir -p "$ROOT/out/cache"
+if ((${#SIM_SETS[@]})); then
+  # The changed simulator config, kept under its content's hash (it names its rig file relative
+  # to the repo root, where the simulator runs).
+  changed="$(mktemp "$ROOT/out/cache/sim-XXXXXX.yaml")"
+  cp "$sim_config" "$changed"
+  for item in "${SIM_SETS[@]}"; do
+    [[ $item =~ ^([A-Za-z0-9_.]+)=(.*)$ ]] || die "--sim-set $item: expected KEY=VALUE"
+    "$PYTHON" "$ROOT/scripts/conf.py" set "$changed" "${BASH_REMATCH[1]}" "${BASH_REMATCH[2]}" \
+      >"$changed.tmp" || die "--sim-set $item: cannot set ${BASH_REMATCH[1]} in $sim_config"
+    mv "$changed.tmp" "$changed"
+  done
+  sim_hash="$(sha1sum <"$changed" | cut -c 1-6)"
+  sim_tag="-sim$sim_hash"
+  sim_config="$ROOT/out/cache/sim-$sim_hash.yaml"
+  mv "$changed" "$sim_config"
+fi
 inputs_hash="$(cat "$route_file" "$world_file" "$sim_config" "$rig_config" | sha1sum | cut -c 1-10)"
-run_name="$route-seed$seed${duration:+-d$duration}-$profile${WHEEL_ENCODERS:+-wheels}"
+run_name="$route-seed$seed${duration:+-d$duration}-$profile${WHEEL_ENCODERS:+-wheels}$sim_tag"
 # Only the mapper reads the tilted profile scanner: without it the log leaves profiles out (a
 # third less to simulate and store). Every other stream is drawn from its own generator, so the
 # scans, IMU and ground truth are the same either way.
@@ -108,14 +133,13 @@ if ! runs_mapper "$stages"; then
   run_name="$run_name-noprofiles"
 fi
 cache="$ROOT/out/cache/$run_name-$inputs_hash.lcmlog"
-mkdir -p "$ROOT/out/cache"
 if stale "$cache" "$BIN/traverse-sim"; then
   # Logs of the same run made from other inputs are of no more use (they are large).
   rm -f "$ROOT/out/cache/$run_name"-??????????.lcmlog
   echo "eval-route: simulating $route (seed $seed, $profile) -> $cache" >&2
   sim_start_ns=$(date +%s%N)
   # From the repo root: configs/sim.yaml names the rig file relative to it.
-  (cd "$ROOT" && "$BIN/traverse-sim" --config configs/sim.yaml --world "$world_file" \
+  (cd "$ROOT" && "$BIN/traverse-sim" --config "$sim_config" --world "$world_file" \
     --route "$route_file" --seed "$seed" --profile "$profile" "${profile_every[@]}" \
     ${duration:+--duration "$duration"} ${WHEEL_ENCODERS:+--wheel-encoders} --out "$cache.tmp" >&2) || die "traverse-sim failed"
   mv "$cache.tmp" "$cache"
@@ -134,4 +158,4 @@ merged_json "$("$PYTHON" "$ROOT/scripts/conf.py" object route="$route" seed:="$s
   profile="$profile" sim_duration_s:="${duration:-null}" stages="$stages" speed:="$speed" \
   offline:="$([[ -n $OFFLINE ]] && echo true || echo false)" \
   deskew_off:="$([[ -n $DESKEW_OFF ]] && echo true || echo false)" tag="$tag" \
-  config_sets:="$(config_sets_json)" sim_log="$cache" out_dir="$out")"
+  config_sets:="$(config_sets_json)" sim_sets:="$("$PYTHON" -c 'import json, sys; print(json.dumps(sys.argv[1:]))' "${SIM_SETS[@]}")" sim_log="$cache" out_dir="$out")"

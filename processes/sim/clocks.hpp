@@ -37,6 +37,12 @@ struct SensorClock {
     return c;
   }
 
+  // [us] what the clock reads at true time `true_utime`, `t_s` [s] after the start (no jitter).
+  int64_t reading(int64_t true_utime, double t_s) const {
+    if (!enabled) return true_utime;
+    return true_utime + std::llround(1e6 * (offset_s + drift * t_s));
+  }
+
   // [us] stamp of message k taken at true time `true_utime`, `t_s` [s] after the start.
   int64_t stamp(int64_t true_utime, double t_s, int64_t k) const {
     if (!enabled) return true_utime;

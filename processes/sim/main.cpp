@@ -167,6 +167,20 @@ int main(int argc, char** argv) {
   json["real_time_factor"] = traverse::json_fixed(sim_s / std::max(wall_s, 1e-9), 3);
   json["route_length_m"] = traverse::json_fixed(simulator->trajectory().length_m(), 2);
   json["route_duration_s"] = traverse::json_fixed(simulator->trajectory().duration_s(), 2);
+  // What the realistic profile drew for this run, for analyses that need the truth (the processes
+  // are never told): each sensor clock's offset [ms] and drift [ppm] (stamp = true time + offset +
+  // drift x time since the start + jitter), and each sensor's extrinsic error against the rig file.
+  const sim::RunTruth& truth = simulator->truth();
+  const auto clock_json = [](const sim::SensorClock& c) {
+    traverse::Json j;
+    j["offset_ms"] = traverse::json_fixed(1e3 * c.offset_s, 4);
+    j["drift_ppm"] = traverse::json_fixed(1e6 * c.drift, 3);
+    return j;
+  };
+  json["true_clocks"]["laser_horizontal"] = clock_json(truth.horizontal_clock);
+  json["true_clocks"]["laser_profile"] = clock_json(truth.profile_clock);
+  json["true_clocks"]["imu"] = clock_json(truth.imu_clock);
+  json["true_clocks"]["odometry"] = clock_json(truth.odometry_clock);
   std::printf("%s\n", traverse::json_line(json).c_str());
   return rc;
 }

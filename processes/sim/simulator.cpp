@@ -185,8 +185,15 @@ int64_t Simulator::stream_stamp(int s) const {
   const int64_t k = next_index_[s];
   int64_t u = 0;
   switch (s) {
-    case 0:
-      return clock_.sample_utime(k, rig_.ground_truth_rate_hz);
+    case 0: {
+      // The truth in the horizontal scanner's time base (its clock without jitter): every pose the
+      // graph estimates carries a scan's stamp, and no sensor of the cart sees true time, so an
+      // estimate is compared with the truth at the instant its stamp names on the scanner's
+      // clock. Stamped in true time, a key pose on an arc read omega x (offset + drift x t) off
+      // in heading (41 ppm after 700 s at 0.6 rad/s: 1.2 deg) that no process could observe.
+      const int64_t u_true = clock_.sample_utime(k, rig_.ground_truth_rate_hz);
+      return truth_.horizontal_clock.reading(u_true, clock_.seconds(u_true));
+    }
     case 1:
       u = imu_->sample_stamp(k);
       break;
@@ -229,7 +236,7 @@ std::optional<SimEvent> Simulator::next() {
     case 0: {
       ev.kind = SimEvent::Kind::kGroundTruth;
       const Pose2 p = trajectory_.pose(clock_.seconds(true_utime));
-      ev.ground_truth = {true_utime, p, trajectory_.lift(p)};
+      ev.ground_truth = {best_stamp, p, trajectory_.lift(p)};
       break;
     }
     case 1:

@@ -5,7 +5,8 @@
 // how the streams interleave, and the same inputs and seed always give the same sequence.
 // A scan is stamped (and ordered) by the time of its first beam, as planar_scan_t defines. With
 // the realistic profile's clocks each stream is stamped (and ordered) by its own clock, the
-// ground truth by the true one.
+// ground truth by the horizontal scanner's clock without its jitter: the time base of every pose
+// the graph estimates (a scan's stamp), against which the other sensors' clocks are off.
 #pragma once
 
 #include <cstdint>
@@ -49,7 +50,7 @@ struct RunOptions {
 };
 
 struct GroundTruth {
-  int64_t utime = 0;
+  int64_t utime = 0;   // [us] on the horizontal scanner's clock (true time without clocks)
   Pose2 T_world_base;  // planar projection: x, y, yaw
   Eigen::Isometry3d T_world_base_3d = Eigen::Isometry3d::Identity();
 };
