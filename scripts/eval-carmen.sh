@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # scripts/eval-carmen.sh NAME|PATH [--stages LIST] [--speed S] [--offline]
 #                        [--set PROCESS.KEY=VALUE ...] [--tag NAME] [--record-outputs-only]
-#                        [--verdict-warns]
+#                        [--verdict-warns] [--reuse-frontend]
 #
 # One command per evaluation on a real CARMEN log: converts ../shared/data/carmen/NAME-corrected.log.gz
 # (or any CARMEN log PATH) with traverse-carmen (cached as out/cache/carmen-NAME.lcmlog,
@@ -17,12 +17,14 @@
 #   --offline      run the stages one after another on the log (--replay/--record) instead of
 #                  live on a bus: no transport loss, as fast as they compute, the same figures
 #                  every time; --speed is then ignored
-#   --set, --tag, --record-outputs-only, --verdict-warns   as scripts/eval-route.sh's (outputs
-#                  under carmen-NAME-STAGES-TAG)
+#   --set, --tag, --record-outputs-only, --verdict-warns, --reuse-frontend   as
+#                  scripts/eval-route.sh's (outputs under carmen-NAME-STAGES-TAG; the reused
+#                  frontend run is out/eval/carmen-NAME-frontend)
 set -euo pipefail
 OFFLINE=""
 RECORD_OUTPUTS_ONLY=""
 VERDICT_WARNS=""
+REUSE=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -36,6 +38,7 @@ while (($#)); do
     --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
     --record-outputs-only) RECORD_OUTPUTS_ONLY=1; shift ;;
     --verdict-warns) VERDICT_WARNS=1; shift ;;
+    --reuse-frontend) REUSE=1; shift ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $what ]] || usage; what="$1"; shift ;;
@@ -54,6 +57,7 @@ convert_carmen_log "$input" "$cache"
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
 out="$ROOT/out/eval/carmen-$name-$(stages_tag "$stages")${tag:+-$tag}"
+[[ -z $REUSE ]] || REUSE_FRONTEND="$ROOT/out/eval/carmen-$name-frontend"
 run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_REFERENCE
 echo "eval-carmen: $name stages ${stages:-none}: outputs in $out" >&2
 merged_json "$("$PYTHON" "$ROOT/scripts/conf.py" object carmen="$name" stages="$stages" \

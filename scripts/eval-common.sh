@@ -207,8 +207,28 @@ evaluate() {
 # run_and_evaluate IN OUTDIR STAGES SPEED REFERENCE: with no stage, the reference against itself
 # (a smoke test: every error is zero); otherwise the stages run on IN through the graph and the
 # last stage's trajectory is evaluated against REFERENCE. The evaluator's JSON goes to EVAL_JSON.
+# REUSE_FRONTEND=FOLDER (--reuse-frontend): a stage list that starts with the frontend takes the
+# frontend's output from FOLDER/run.lcmlog, an offline `--stages frontend` run of the same input
+# (made first when it is missing or was not offline), and runs only the later stages on it.
+# Offline, each stage reads the previous stage's whole record, so this gives the same messages as
+# running every stage, without the frontend's time (most of a run's).
 run_and_evaluate() {
   local in="$1" out="$2" stages="$3" speed="$4" ref="$5"
+  if [[ -n ${REUSE_FRONTEND:-} && $stages == frontend,* ]]; then
+    [[ -n ${OFFLINE:-} ]] || die "--reuse-frontend needs --offline"
+    local fe="$REUSE_FRONTEND" set
+    for set in "${CONFIG_SETS[@]}"; do
+      [[ $set != frontend.* ]] || die "--reuse-frontend reuses the frontend's output: no --set $set"
+    done
+    if [[ ! -s $fe/run.lcmlog ]] || ! grep -q "offline stage 'frontend'" "$fe/graph.out" 2>/dev/null; then
+      echo "$(basename "$0"): running the frontend alone first (reused later): $fe" >&2
+      (RECORD_OUTPUTS_ONLY="" CONFIG_SETS=() && run_and_evaluate "$in" "$fe" frontend "$speed" "$ref") ||
+        exit 1
+    fi
+    echo "$(basename "$0"): the frontend's output reused from $fe/run.lcmlog" >&2
+    in="$fe/run.lcmlog"
+    stages="${stages#frontend,}"
+  fi
   rm -rf "$out"
   mkdir -p "$out"
   if [[ -z $stages ]]; then

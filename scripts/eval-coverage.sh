@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# scripts/eval-coverage.sh [--fit] [--runs LIST] [--fit-runs LIST] [--keep-logs]
+# scripts/eval-coverage.sh [--fit] [--runs LIST] [--fit-runs LIST] [--keep-logs] [--profile P]
+#                          [--reuse-frontend] [--set PROCESS.KEY=VALUE ...] [--tag NAME]
 #
 # Does the annotator's 95 % bound hold? For each run (ROUTE:SEED on the realistic simulator
-# profile) the graph runs frontend, backend and annotator offline (scripts/eval-route.sh), and
+# profile, or --profile ideal) the graph runs frontend, backend and annotator offline (scripts/eval-route.sh), and
 # traverse-annotator-eval compares every key pose's true position error (ground truth aligned at the
 # first key pose, which fixes the frame) with its 95 % bound, the annotations recomputed from the
 # run's backend messages with the current configs/annotator.yaml. Prints per run the coverage (share
@@ -19,12 +20,18 @@
 #   --keep-logs      keep each run's full log and simulated log (by default only a compact log of
 #                    what the evaluation reads is kept, out/eval/<run>/coverage.lcmlog: a full
 #                    office run is over a gigabyte)
+#   --profile P      the simulator's profile, realistic (default) or ideal
+#   --reuse-frontend each run's frontend output comes from its offline frontend run (made once,
+#                    kept: scripts/eval-route.sh --reuse-frontend), so trying backend settings
+#                    costs the backend's and annotator's time only
+#   --set P.K=V, --tag NAME  as scripts/eval-route.sh's: the graph with a config key changed, its
+#                    runs in folders named with the tag
 # A run whose compact log exists is not run again (delete its folder to rerun it).
 set -euo pipefail
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
-fit="" keep="" fit_runs="court-loop:1,office-s1:1"
+fit="" keep="" reuse="" profile=realistic tag="" sets=() fit_runs="court-loop:1,office-s1:1"
 runs=""
 held_out="court-loop:2,court-loop:3,corridor-return:1,office-s2:1,office-s3:2"
 while (($#)); do
@@ -33,17 +40,23 @@ while (($#)); do
     --runs) runs="${2:?--runs needs a list}"; shift 2 ;;
     --fit-runs) fit_runs="${2:?--fit-runs needs a list}"; shift 2 ;;
     --keep-logs) keep=1; shift ;;
+    --profile) profile="${2:?--profile needs ideal or realistic}"; shift 2 ;;
+    --reuse-frontend) reuse=1; shift ;;
+    --set) sets+=(--set "${2:?--set needs PROCESS.KEY=VALUE}"); shift 2 ;;
+    --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
     -h | --help) usage 0 ;;
     *) echo "unknown option $1" >&2; usage ;;
   esac
 done
 [[ -n $runs ]] || runs="$fit_runs,$held_out"
+[[ $profile == ideal || $profile == realistic ]] || die "--profile must be ideal or realistic, not '$profile'"
+check_tag "$tag"
 need_programs traverse-annotator-eval traverse-annotator
 config="$ROOT/configs/annotator.yaml"
 stages="frontend,backend,annotator"
 
 run_dir() {  # ROUTE SEED
-  echo "$ROOT/out/eval/$1-seed$2-realistic-noprofiles-$(stages_tag "$stages")"
+  echo "$ROOT/out/eval/$1-seed$2-$profile-noprofiles-$(stages_tag "$stages")${tag:+-$tag}"
 }
 
 # The run's compact log, running the graph first when there is none.
@@ -54,6 +67,7 @@ ensure_run() {  # ROUTE SEED
   if [[ ! -s $dir/run.lcmlog ]]; then
     echo "eval-coverage: running $route seed $seed ($stages, offline)" >&2
     "$ROOT/scripts/eval-route.sh" "$route" --seed "$seed" --stages "$stages" --offline \
+      --profile "$profile" ${reuse:+--reuse-frontend} "${sets[@]}" ${tag:+--tag "$tag"} \
       >"$dir.route.out" 2>&1 || { tail -n 5 "$dir.route.out" >&2; die "eval-route failed for $route seed $seed"; }
   fi
   "$BIN/traverse-annotator-eval" --log "$dir/run.lcmlog" --compact "$dir/coverage.lcmlog.tmp" \

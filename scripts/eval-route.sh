@@ -2,7 +2,7 @@
 # scripts/eval-route.sh ROUTE [--stages LIST] [--seed N] [--profile P] [--speed S] [--offline]
 #                       [--duration S] [--deskew-off] [--set PROCESS.KEY=VALUE ...] [--tag NAME]
 #                       [--record-outputs-only] [--verdict-warns] [--wheel-encoders]
-#                       [--sim-set KEY=VALUE ...]
+#                       [--sim-set KEY=VALUE ...] [--reuse-frontend]
 #
 # One command per evaluation on the simulator: generates the log of configs/routes/ROUTE.yaml with
 # traverse-sim, configs/sim.yaml and configs/rig.yaml (cached as
@@ -39,6 +39,12 @@
 #                  evaluation needs, a small part of the size
 #   --wheel-encoders  the simulated cart also publishes wheel odometry on ODOMETRY (traverse-sim
 #                  --wheel-encoders; cached and evaluated under ROUTE-seedN-PROFILE-wheels)
+#   --reuse-frontend  with --offline and stages that start with the frontend: the frontend's
+#                  output is taken from the offline `--stages frontend` run of the same route, seed
+#                  and profile (out/eval/ROUTE-seedN-PROFILE[-noprofiles]-frontend, made first when
+#                  missing) and only the later stages run: the same messages as running them all,
+#                  in a fraction of the time (to try backend or annotator settings; delete that
+#                  folder after changing the frontend or its config)
 #   --verdict-warns  a run whose verdict fails (run-graph exit 3: every process ran to the end
 #                  but the monitor found messages lost or a process stalled) is evaluated anyway;
 #                  the JSON's graph.ok is false (without it the script fails)
@@ -50,6 +56,7 @@ VERDICT_WARNS=""
 WHEEL_ENCODERS=""
 SIM_SETS=()
 sim_tag=""  # -simHASH with --sim-set: the changed config's log and outputs apart from the others
+REUSE=""
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
@@ -74,6 +81,7 @@ while (($#)); do
     --record-outputs-only) RECORD_OUTPUTS_ONLY=1; shift ;;
     --verdict-warns) VERDICT_WARNS=1; shift ;;
     --wheel-encoders) WHEEL_ENCODERS=1; shift ;;
+    --reuse-frontend) REUSE=1; shift ;;
     -h | --help) usage 0 ;;
     -*) echo "unknown option $1" >&2; usage ;;
     *) [[ -z $route ]] || usage; route="$1"; shift ;;
@@ -148,6 +156,7 @@ fi
 
 # 2. The stages on it, 3. the evaluation of the last stage's trajectory.
 out="$ROOT/out/eval/$run_name-$(stages_tag "$stages")${DESKEW_OFF:+-deskew-off}${tag:+-$tag}"
+[[ -z $REUSE ]] || REUSE_FRONTEND="$ROOT/out/eval/$run_name-frontend"
 run_and_evaluate "$cache" "$out" "$stages" "$speed" POSE_GROUND_TRUTH
 if runs_mapper "$stages"; then
   need_programs traverse-cloud-eval

@@ -35,6 +35,9 @@ std::optional<std::string> validate(const BackendConfig& c) {
   check.positive("link_covariance_scale", c.link_covariance_scale);
   check.positive("frontend_covariance_scale", c.frontend_covariance_scale);
   check.not_negative("frontend_drift_length_m", c.frontend_drift_length_m);
+  check.not_negative("frame_heading_sigma_rad", c.frame_heading_sigma_rad);
+  check.not_negative("key_pose_sigma_xy_m", c.key_pose_sigma_xy_m);
+  check.positive("marginal_scale", c.marginal_scale);
   check.nested("odometry", validate(c.odometry));
   check.nested("loop", validate(c.loop));
   check.not_negative("closure_max_chi2_increase", c.closure_max_chi2_increase);
@@ -106,6 +109,17 @@ std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
   if (closure) add_closure(*closure);
   if (closure || current % config_.optimize_every == 0) return optimise();
   return std::nullopt;
+}
+
+Eigen::Matrix3d Backend::published_covariance(int i) const {
+  if (i == 0) return Eigen::Matrix3d::Zero();
+  // A turn of the frame by d rad about the first key pose moves key pose i by J d.
+  const Eigen::Vector2d r =
+      key_poses_[i].T_world_base.translation() - key_poses_[0].T_world_base.translation();
+  const Eigen::Vector3d J(-r.y(), r.x(), 1.0);
+  const double sf = config_.frame_heading_sigma_rad, sp = config_.key_pose_sigma_xy_m;
+  return config_.marginal_scale * key_poses_[i].covariance + sf * sf * J * J.transpose() +
+         Eigen::Vector3d(sp * sp, sp * sp, 0.0).asDiagonal().toDenseMatrix();
 }
 
 std::pair<Eigen::Matrix3d, Eigen::Matrix3d> Backend::frontend_covariances() const {

@@ -86,6 +86,21 @@ struct BackendConfig {
   bool frontend_covariance = true;
   double frontend_covariance_scale = 1.0;  // [unitless]
   double frontend_drift_length_m = 0.0;    // [m]
+  // Two errors no edge of the graph can hold, added to the marginal covariances the backend
+  // publishes (published_covariance) and not to the optimisation, whose optimum neither moves:
+  // the frame's own heading, which the first key pose fixes through the horizontal scanner's
+  // boresight calibration (a rotation of the whole graph about the first key pose: the absolute
+  // position error grows with the distance from there; relative poses keep none of it), and each
+  // key pose's error against the moment it is stamped with (sensor clocks: the cart moves on
+  // while a stamp is late). 0: none.
+  double frame_heading_sigma_rad = 0.0;  // [rad]
+  double key_pose_sigma_xy_m = 0.0;      // [m]
+  // The graph's marginals, and the information of the edges it publishes, are published this
+  // many times too large (too small): the edges' covariances calibrated at once against the
+  // errors they allow (configs/backend.yaml has the fit). One factor on every edge of the graph
+  // does not move its optimum; the loop closer's check keeps the unscaled marginals, so nothing
+  // the backend estimates changes with it.
+  double marginal_scale = 1.0;  // [unitless]
   // Wheel odometry, when there is any, as a check on each frontend step (odometry_check.hpp).
   OdometryCheckConfig odometry;
   LoopCloserConfig loop;
@@ -116,6 +131,9 @@ struct BackendConfig {
     v("frontend_covariance", frontend_covariance);
     v("frontend_covariance_scale", frontend_covariance_scale);
     v("frontend_drift_length_m", frontend_drift_length_m);
+    v("frame_heading_sigma_rad", frame_heading_sigma_rad);
+    v("key_pose_sigma_xy_m", key_pose_sigma_xy_m);
+    v("marginal_scale", marginal_scale);
     v("odometry", odometry);
     v("loop", loop);
     v("closure_max_chi2_increase", closure_max_chi2_increase);
@@ -215,7 +233,13 @@ class Backend {
   const std::vector<EdgeKind>& edge_kinds() const { return edge_kinds_; }
   // The graph's edges between key poses only, in the order they were added (KeyEdge).
   const std::vector<KeyEdge>& key_edges() const { return key_edges_; }
+  const BackendConfig& config() const { return config_; }
   const std::vector<KeyPose>& key_poses() const { return key_poses_; }
+  // Key pose i's covariance as published: its marginal (KeyPose::covariance, which the loop
+  // closer's check uses) times marginal_scale, with the frame's heading and the key pose's own
+  // error of the config (frame_heading_sigma_rad, key_pose_sigma_xy_m). Zero for the first key
+  // pose.
+  Eigen::Matrix3d published_covariance(int i) const;
   const ScanStore& scans() const { return scans_; }
   const std::vector<LoopClosure>& closures() const { return closures_; }
   const LoopCloserCounters& loop_counters() const { return loop_.counters(); }

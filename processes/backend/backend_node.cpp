@@ -109,7 +109,7 @@ bool BackendNode::changed(int i) const {
   if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
     return true;
   }
-  const Eigen::Vector3d v = backend_.key_poses()[i].covariance.diagonal();
+  const Eigen::Vector3d v = backend_.published_covariance(i).diagonal();
   for (int k = 0; k < 3; ++k) {
     if (std::abs(v[k] - p.variances[k]) >
         config_.publish_covariance_change * std::abs(p.variances[k]))
@@ -148,7 +148,8 @@ void BackendNode::publish_edges(std::size_t first, std::size_t last, int32_t opt
       m.x = e.T_from_to.x();
       m.y = e.T_from_to.y();
       m.theta = e.T_from_to.theta();
-      copy_matrix(e.information, m.information);
+      // The edges as the published marginals see them (BackendConfig::marginal_scale).
+      copy_matrix(e.information / backend_.config().marginal_scale, m.information);
       msg.edges.push_back(m);
     }
     msg.n_edges = static_cast<int32_t>(msg.edges.size());
@@ -167,7 +168,9 @@ void BackendNode::publish(const BackendUpdate& update) {
     if (changed(i)) changed_ids.push_back(i);
   }
   published_.resize(keys.size());
-  for (int i : changed_ids) published_[i] = {keys[i].T_world_base, keys[i].covariance.diagonal()};
+  for (int i : changed_ids) {
+    published_[i] = {keys[i].T_world_base, backend_.published_covariance(i).diagonal()};
+  }
   publish_key_poses(changed_ids, keys.size(), update, config_.key_poses_channel);
   last_update_ = update;
   last_update_.new_key_poses.clear();
@@ -182,7 +185,7 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.x = keys[i].T_world_base.x();
     pose.y = keys[i].T_world_base.y();
     pose.theta = keys[i].T_world_base.theta();
-    copy_matrix(keys[i].covariance, pose.covariance);
+    copy_matrix(backend_.published_covariance(i), pose.covariance);
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
   }
@@ -215,7 +218,7 @@ void BackendNode::publish_key_poses(const std::vector<int>& ids, std::size_t n_k
       p.x = keys[i].T_world_base.x();
       p.y = keys[i].T_world_base.y();
       p.theta = keys[i].T_world_base.theta();
-      copy_matrix(keys[i].covariance, p.covariance);
+      copy_matrix(backend_.published_covariance(i), p.covariance);
       msg.poses.push_back(p);
     }
     msg.n_poses = static_cast<int32_t>(msg.poses.size());

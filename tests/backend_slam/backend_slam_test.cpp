@@ -99,6 +99,53 @@ TEST(Backend, SmoothsAFrontendJumpAway) {
       0.05);
 }
 
+// The graph's marginals scaled (marginal_scale), the frame's heading and each key pose's own error
+// (frame_heading_sigma_rad, key_pose_sigma_xy_m) added: in the published marginals and nowhere
+// else; the optimum and the graph's own marginals (which the loop closer's check uses) stay as
+// they were.
+TEST(Backend, PublishedCovarianceAddsTheFramesHeadingAndTheKeyPosesOwnError) {
+  const test::Drive d = test::drive_ellipse(6.0);
+  BackendConfig plain;
+  BackendConfig reported = plain;
+  reported.frame_heading_sigma_rad = 0.004;
+  reported.key_pose_sigma_xy_m = 0.01;
+  reported.marginal_scale = 50.0;
+  ASSERT_EQ(validate(reported), std::nullopt);
+  Backend a(plain), b(reported);
+  for (std::size_t k = 0; k < d.utimes.size(); ++k) {
+    a.add_scan(d.scans[k]);
+    a.add_pose(d.utimes[k], d.input[k]);
+    b.add_scan(d.scans[k]);
+    b.add_pose(d.utimes[k], d.input[k]);
+  }
+  a.finish();
+  b.finish();
+  ASSERT_EQ(a.key_poses().size(), b.key_poses().size());
+  ASSERT_GT(a.key_poses().size(), 10u);
+  EXPECT_EQ(b.published_covariance(0).norm(), 0.0);  // the first key pose fixes the frame
+  const Eigen::Vector2d t0 = b.key_poses()[0].T_world_base.translation();
+  for (std::size_t i = 1; i < b.key_poses().size(); ++i) {
+    const KeyPose& ka = a.key_poses()[i];
+    const KeyPose& kb = b.key_poses()[i];
+    EXPECT_EQ((ka.T_world_base.translation() - kb.T_world_base.translation()).norm(), 0.0);
+    EXPECT_EQ((ka.covariance - kb.covariance).norm(), 0.0);
+    EXPECT_EQ((a.published_covariance(static_cast<int>(i)) - ka.covariance).norm(), 0.0);
+    // A turn of the frame moves key pose i across the line from the first key pose: its
+    // variance that way grows by (sigma r)^2, along the line by nothing; both by the key pose's
+    // own (1 cm)^2; its heading by sigma^2.
+    const Eigen::Matrix3d added =
+        b.published_covariance(static_cast<int>(i)) - 50.0 * kb.covariance;
+    const Eigen::Vector2d r = kb.T_world_base.translation() - t0;
+    if (r.norm() < 0.1) continue;  // [m] no direction yet
+    const Eigen::Vector2d across = Eigen::Vector2d(-r.y(), r.x()).normalized();
+    const Eigen::Vector2d along = r.normalized();
+    const Eigen::Matrix2d P = added.topLeftCorner<2, 2>();
+    EXPECT_NEAR(across.dot(P * across), 0.004 * 0.004 * r.squaredNorm() + 1e-4, 1e-12);
+    EXPECT_NEAR(along.dot(P * along), 1e-4, 1e-12);
+    EXPECT_NEAR(added(2, 2), 0.004 * 0.004, 1e-15);
+  }
+}
+
 // Stamps that carry no time (a log whose first stamps are negative and whose others were printed
 // to 10^4 s, so that runs of poses share one stamp): before, the backend's smoothing extrapolated
 // 25 km steps from them, the correlative matcher sized its table by the result (std::bad_alloc)
