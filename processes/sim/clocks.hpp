@@ -37,10 +37,13 @@ struct SensorClock {
     return c;
   }
 
+  // [s] how far the clock runs ahead of true time `t_s` [s] after the start (no jitter).
+  double error_s(double t_s) const { return offset_s + drift * t_s; }
+
   // [us] what the clock reads at true time `true_utime`, `t_s` [s] after the start (no jitter).
   int64_t reading(int64_t true_utime, double t_s) const {
     if (!enabled) return true_utime;
-    return true_utime + std::llround(1e6 * (offset_s + drift * t_s));
+    return true_utime + std::llround(1e6 * error_s(t_s));
   }
 
   // [us] stamp of message k taken at true time `true_utime`, `t_s` [s] after the start.
@@ -48,7 +51,7 @@ struct SensorClock {
     if (!enabled) return true_utime;
     Rng rng(seed, stream + 0x100000000ULL * static_cast<uint64_t>(k + 1));
     const double jitter = jitter_s * std::clamp(rng.normal(), -2.0, 2.0);
-    return true_utime + std::llround(1e6 * (offset_s + drift * t_s + jitter));
+    return true_utime + std::llround(1e6 * (error_s(t_s) + jitter));
   }
 };
 
