@@ -61,6 +61,9 @@ std::optional<std::string> validate(const MatcherConfig& c) {
                 "sparse_lag_window_rad", "must be in (0, pi]");
   check.not_negative("sparse_lag_long_weight", c.sparse_lag_long_weight);
   check.not_negative("sparse_lag_margin", c.sparse_lag_margin);
+  check.in_range("sparse_widen_evidence_ratio", c.sparse_widen_evidence_ratio, 0.0, 1.0);
+  check.require(c.sparse_widen_factor > 1.0, "sparse_widen_factor", "must be above 1");
+  check.positive("sparse_widen_max_window_m", c.sparse_widen_max_window_m);
   check.in_range("degeneracy_min_ratio", c.degeneracy_min_ratio, 0.0, 1.0);
   check.in_range("moved_max_probability", c.moved_max_probability, 0.0, 0.5);
   return check.problem();

@@ -160,6 +160,15 @@ struct MatcherConfig {
   double sparse_lag_window_rad = 0.2;
   double sparse_lag_long_weight = 0.2;  // [per point]
   double sparse_lag_margin = 0.1;       // [per point, evidence -1 to 1]
+  // Sparse widening (sparse/widen.hpp): a sparse scan (without odometry) whose match fits worse
+  // than sparse_widen_evidence_ratio times the median evidence of the last sparse matches is
+  // searched again in windows sparse_widen_factor times wider, up to sparse_widen_max_window_m
+  // (+- in x and y), and moved where a wider window fits it as well as usual and sparse_lag_margin
+  // per point better than before. A step of 3 m where the log usually steps 0.6 m
+  // (tests/carmen/long_step_test.cpp). 0 for the ratio turns it off.
+  double sparse_widen_evidence_ratio = 0.7;
+  double sparse_widen_factor = 2.0;
+  double sparse_widen_max_window_m = 8.0;  // [m]
 
   template <class V>
   void visit(V& v) {
@@ -195,6 +204,9 @@ struct MatcherConfig {
     v("sparse_lag_window_rad", sparse_lag_window_rad);
     v("sparse_lag_long_weight", sparse_lag_long_weight);
     v("sparse_lag_margin", sparse_lag_margin);
+    v("sparse_widen_evidence_ratio", sparse_widen_evidence_ratio);
+    v("sparse_widen_factor", sparse_widen_factor);
+    v("sparse_widen_max_window_m", sparse_widen_max_window_m);
   }
 };
 
