@@ -42,6 +42,7 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
         channels::full_channel(config_.annotations_channel),
         [this](const annotations_t& m) { on_annotations(m); }, true);
     request_resend(bus, "mapper", {config_.annotations_channel});
+    ++resend_requests_sent_;
   }
   if (preview_) {
     resend_store_ =
@@ -326,6 +327,7 @@ void MapperNode::report_counters() {
   counters_("profiles", s.profiles);
   counters_("annotated_key_poses", static_cast<double>(colours_.size()));
   counters_("annotation_level_changes", level_changes_);
+  counters_("resend_requests_sent", resend_requests_sent_);
   counters_("voxels_coloured", static_cast<double>(voxel_colours_.voxels));
   counters_("voxels_annotated", static_cast<double>(voxel_colours_.annotated));
   counters_("profiles_pending", s.pending);

@@ -389,6 +389,8 @@ TEST_P(GraphTest, ALateListenerGetsEverySegmentAndPreviewProfileAgain) {
   mapper_->report_counters();
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 2.0);
   EXPECT_EQ(mapper_counters_.at("resend_answers"), 1.0);
+  EXPECT_EQ(mapper_counters_.at("resend_requests"), 1.0);
+  EXPECT_EQ(mapper_counters_.at("resend_requests_sent"), 1.0);  // the annotations, at start
 }
 
 // The mapper keeps what it resends under preview.resend_max_bytes: after a run longer than that,
