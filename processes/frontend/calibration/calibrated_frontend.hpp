@@ -1,5 +1,6 @@
 // A frontend of any kind wrapped so that its poses come out in the frame of the base the rig
-// file meant, with the scanner's yaw on the cart estimated while it runs (extrinsic_yaw.hpp).
+// file meant, with the scanner's yaw on the cart estimated while it runs
+// (common/extrinsic_yaw.hpp).
 //
 // The inner frontend matches scans in the frame bhat the rig file's T_base_laser gives the scans
 // (the true base turned by the scanner's yaw error delta, T_base_bhat = Rot(delta)); its map and
