@@ -292,6 +292,7 @@ void BackendNode::report_counters() {
   counters_("graph_requests", static_cast<double>(graph_requests_));
   counters_("graph_answers", static_cast<double>(graph_answers_));
   counters_("boresight_yaw_rad", backend_.boresight().yaw_rad().value_or(0.0));
+  counters_("boresight_estimate_rad", backend_.boresight().estimate_rad());
   counters_("boresight_yaw_sigma_rad", backend_.boresight().yaw_sigma_rad());
   counters_("boresight_chords", static_cast<double>(backend_.boresight().chords()));
   if (!state_) return;

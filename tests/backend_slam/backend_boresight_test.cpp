@@ -7,6 +7,7 @@
 #include <map>
 
 #include "backend.hpp"
+#include "cart_path.hpp"
 #include "synthetic.hpp"
 
 namespace traverse::backend {
@@ -122,6 +123,28 @@ TEST(BackendBoresight, AGraphFromATurnedScannerIsPublishedTurnedBack) {
         plain.published_covariance(static_cast<int>(i)).topLeftCorner<2, 2>();
     EXPECT_LT(across.dot(P * across), across.dot(P_off * across));
   }
+}
+
+// A rig file that is right is left as it is: an estimate within min_sigmas of zero is not applied
+// (key poses a third of a metre apart along 84 m, 2 mm of noise), one of 0.003 rad is.
+TEST(BackendBoresight, AppliedOnlyWhenItDiffersFromTheRigFile) {
+  BoresightConfig config;
+  config.enabled = true;
+  for (const double delta : {0.0, 0.003}) {
+    Boresight boresight(config);
+    boresight.update(
+        traverse::test::as_tracked(traverse::test::cart_path(0.33, 0.0), delta, 0.002, 9));
+    EXPECT_GT(boresight.travel_m(), 50.0);
+    EXPECT_LT(std::abs(boresight.estimate_rad() - delta), 5e-4) << delta;
+    EXPECT_EQ(boresight.yaw_rad().has_value(), delta != 0.0) << boresight.estimate_rad();
+    const Pose2 T(10.0, 0.0, 0.3);
+    const Pose2 published = boresight.published(T, Pose2());
+    EXPECT_NEAR(published.y(), 10.0 * std::sin(boresight.yaw_rad().value_or(0.0)), 1e-12);
+  }
+  config.min_sigmas = 0.0;  // every estimate applied
+  Boresight any(config);
+  any.update(traverse::test::as_tracked(traverse::test::cart_path(0.33, 0.0), 0.0, 0.002, 9));
+  EXPECT_TRUE(any.yaw_rad().has_value());
 }
 
 TEST(BackendBoresight, ConfigValidationNamesTheKey) {
