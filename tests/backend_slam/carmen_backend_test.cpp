@@ -178,10 +178,10 @@ Result run(const Log& log, const std::vector<FrontendPose>& frontend, const Back
 
   densifier::Densifier densifier(densifier_config);
   for (const FrontendPose& p : frontend) densifier.add_dense(p.utime, p.T_map_base, nullptr);
-  std::vector<densifier::KeyPose> keys;
+  std::vector<densifier::KeyPose> keys;  // as the backend publishes them (its boresight applied)
   for (std::size_t i = 0; i < backend.key_poses().size(); ++i) {
     keys.push_back({static_cast<int64_t>(i), backend.key_poses()[i].utime,
-                    backend.key_poses()[i].T_world_base});
+                    backend.published_pose(static_cast<int>(i))});
   }
   densifier.update_key_poses(keys);
   densifier.settle();
