@@ -6,7 +6,7 @@
 
 #include "config.hpp"
 
-namespace traverse {
+namespace traverse::calibration {
 namespace {
 
 // A chord turning more than this is left out: a turn on the spot, a corner, where its direction
@@ -130,4 +130,4 @@ std::optional<double> ExtrinsicYawEstimator::yaw_rad() const {
   return delta;
 }
 
-}  // namespace traverse
+}  // namespace traverse::calibration

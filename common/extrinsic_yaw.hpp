@@ -30,7 +30,7 @@
 
 #include "se2.hpp"
 
-namespace traverse {
+namespace traverse::calibration {
 
 struct ExtrinsicYawConfig {
   double chord_m = 1.0;        // [m] path chords the fit takes
@@ -91,4 +91,4 @@ class ExtrinsicYawEstimator {
 // about the first pose's, the heading as tracked (the map frame is the base at the first pose).
 Pose2 turned_about(const Pose2& T_map_bhat, const Eigen::Vector2d& origin, double delta);
 
-}  // namespace traverse
+}  // namespace traverse::calibration

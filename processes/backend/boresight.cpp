@@ -10,7 +10,7 @@ std::optional<std::string> validate(const BoresightConfig& c) {
   ConfigCheck check;
   check.in_range("min_sigmas", c.min_sigmas, 0.0, 100.0);
   if (check.problem()) return check.problem();
-  return validate(static_cast<const ExtrinsicYawConfig&>(c));
+  return validate(static_cast<const calibration::ExtrinsicYawConfig&>(c));
 }
 
 void Boresight::update(const std::vector<Pose2>& key_poses) {
@@ -27,7 +27,7 @@ void Boresight::update(const std::vector<Pose2>& key_poses) {
 
 Pose2 Boresight::published(const Pose2& T_world_base, const Pose2& T_world_first) const {
   if (!yaw_) return T_world_base;
-  return turned_about(T_world_base, T_world_first.translation(), *yaw_);
+  return calibration::turned_about(T_world_base, T_world_first.translation(), *yaw_);
 }
 
 Eigen::Matrix3d Boresight::published(const Eigen::Matrix3d& covariance) const {

@@ -25,7 +25,7 @@
 
 namespace traverse::backend {
 
-struct BoresightConfig : ExtrinsicYawConfig {
+struct BoresightConfig : calibration::ExtrinsicYawConfig {
   // Estimate and apply the yaw. Only for a platform that moves along its own x axis (a wheeled
   // cart), and only where the trajectory is wanted in the base's frame: a trajectory scored
   // against a reference made in the scanner's own frame (the CARMEN and relations logs) can only
@@ -41,7 +41,7 @@ struct BoresightConfig : ExtrinsicYawConfig {
   void visit(V& v) {
     v("enabled", enabled);
     v("min_sigmas", min_sigmas);
-    ExtrinsicYawConfig::visit(v);
+    calibration::ExtrinsicYawConfig::visit(v);
   }
 };
 
@@ -72,7 +72,7 @@ class Boresight {
 
  private:
   BoresightConfig config_;
-  ExtrinsicYawEstimator estimator_;
+  calibration::ExtrinsicYawEstimator estimator_;
   std::optional<double> yaw_;
   double sigma_ = 0.0;
 };

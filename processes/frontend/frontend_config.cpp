@@ -114,7 +114,8 @@ std::optional<std::string> validate(const FrontendConfig& c) {
   check.nested("motion_prior", validate(c.motion_prior));
   check.nested("icp", validate(c.icp));
   check.nested("handover", validate(c.handover));
-  check.nested("calibration", validate(static_cast<const ExtrinsicYawConfig&>(c.calibration)));
+  check.nested("calibration",
+               validate(static_cast<const calibration::ExtrinsicYawConfig&>(c.calibration)));
   if (check.problem()) return check.problem();
   // The searches' windows in cells of the level each runs on: the recovery search on the
   // coarsest, the wide search on level 1 (or 0 with one level).

@@ -299,7 +299,7 @@ struct MotionPriorConfig {
 // (common/extrinsic_yaw.hpp). The poses come out in the frame of the base the rig file
 // meant, the map's frame the base at the first scan (initial_pose); odometry is turned into the
 // frame the scans are matched in.
-struct CalibrationConfig : ExtrinsicYawConfig {
+struct CalibrationConfig : calibration::ExtrinsicYawConfig {
   // Estimate and apply the yaw as each pose comes. Off by default: on the relations log intel it
   // made the frontend's mean translational error 0.099 m against 0.021 m without (the estimate
   // turns each new pose about the start by the estimate of the moment, so poses published while
@@ -311,7 +311,7 @@ struct CalibrationConfig : ExtrinsicYawConfig {
   template <class V>
   void visit(V& v) {
     v("extrinsic_yaw", extrinsic_yaw);
-    ExtrinsicYawConfig::visit(v);
+    calibration::ExtrinsicYawConfig::visit(v);
   }
 };
 

@@ -7,7 +7,7 @@
 
 #include "cart_path.hpp"
 
-namespace traverse {
+namespace traverse::calibration {
 namespace {
 
 using test::as_tracked;
@@ -103,4 +103,4 @@ TEST(ExtrinsicYaw, ConfigValidation) {
 }
 
 }  // namespace
-}  // namespace traverse
+}  // namespace traverse::calibration

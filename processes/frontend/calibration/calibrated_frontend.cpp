@@ -25,7 +25,7 @@ std::optional<FrontendResult> CalibratedFrontend::finish() {
 }
 
 Pose2 CalibratedFrontend::to_base(const Pose2& T_map_bhat, double delta) const {
-  return turned_about(T_map_bhat, T_initial_.translation(), delta);
+  return calibration::turned_about(T_map_bhat, T_initial_.translation(), delta);
 }
 
 FrontendResult CalibratedFrontend::calibrated(FrontendResult r) {

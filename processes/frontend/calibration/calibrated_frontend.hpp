@@ -37,7 +37,7 @@ class CalibratedFrontend final : public FrontendWrapper<Frontend> {
   Pose2 to_base(const Pose2& T_map_bhat, double delta) const;
 
   Pose2 T_initial_;
-  ExtrinsicYawEstimator yaw_;
+  calibration::ExtrinsicYawEstimator yaw_;
 };
 
 }  // namespace traverse::frontend
