@@ -109,7 +109,7 @@ void BackendNode::finish() {
 bool BackendNode::changed(int i) const {
   if (i >= static_cast<int>(published_.size())) return true;
   const Published& p = published_[i];
-  const Pose2& T = backend_.key_poses()[i].T_world_base;
+  const Pose2 T = backend_.published_pose(i);
   if ((T.translation() - p.T_world_base.translation()).norm() > config_.publish_move_m) return true;
   if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
     return true;
@@ -174,7 +174,7 @@ void BackendNode::publish(const BackendUpdate& update) {
   }
   published_.resize(keys.size());
   for (int i : changed_ids) {
-    published_[i] = {keys[i].T_world_base, backend_.published_covariance(i).diagonal()};
+    published_[i] = {backend_.published_pose(i), backend_.published_covariance(i).diagonal()};
   }
   publish_key_poses(changed_ids, keys.size(), update, config_.key_poses_channel);
   last_update_ = update;
@@ -187,9 +187,10 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.utime = keys[i].utime;
     pose.parent_frame = "map";  // the frontend's frame, which the graph keeps
     pose.child_frame = "base";
-    pose.x = keys[i].T_world_base.x();
-    pose.y = keys[i].T_world_base.y();
-    pose.theta = keys[i].T_world_base.theta();
+    const Pose2 T = backend_.published_pose(i);
+    pose.x = T.x();
+    pose.y = T.y();
+    pose.theta = T.theta();
     copy_matrix(backend_.published_covariance(i), pose.covariance);
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
@@ -220,9 +221,10 @@ void BackendNode::publish_key_poses(const std::vector<int>& ids, std::size_t n_k
       key_pose_t p{};
       p.utime = keys[i].utime;
       p.id = i;
-      p.x = keys[i].T_world_base.x();
-      p.y = keys[i].T_world_base.y();
-      p.theta = keys[i].T_world_base.theta();
+      const Pose2 T = backend_.published_pose(i);
+      p.x = T.x();
+      p.y = T.y();
+      p.theta = T.theta();
       copy_matrix(backend_.published_covariance(i), p.covariance);
       msg.poses.push_back(p);
     }
@@ -293,6 +295,10 @@ void BackendNode::report_counters() {
   counters_("key_poses_messages", static_cast<double>(messages_));
   counters_("key_poses_message_max_bytes", static_cast<double>(max_message_bytes_));
   resend_->report(counters_);
+  counters_("boresight_yaw_rad", backend_.boresight().yaw_rad().value_or(0.0));
+  counters_("boresight_estimate_rad", backend_.boresight().estimate_rad());
+  counters_("boresight_yaw_sigma_rad", backend_.boresight().yaw_sigma_rad());
+  counters_("boresight_chords", static_cast<double>(backend_.boresight().chords()));
   if (!state_) return;
   const BackendStateCounters& s = state_->counters();
   counters_("state_snapshots", static_cast<double>(s.snapshots));

@@ -101,14 +101,6 @@ std::optional<std::string> validate(const MotionPriorConfig& c) {
   return check.problem();
 }
 
-std::optional<std::string> validate(const CalibrationConfig& c) {
-  ConfigCheck check;
-  check.in_range("chord_m", c.chord_m, 0.05, 100.0);
-  check.in_range("min_travel_m", c.min_travel_m, 0.0, 1e6);
-  check.in_range("max_yaw_rad", c.max_yaw_rad, 0.0, 0.5);
-  return check.problem();
-}
-
 std::optional<std::string> validate(const FrontendConfig& c) {
   ConfigCheck check;
   check.require(c.kind == "hector" || c.kind == "icp", "kind",
@@ -125,7 +117,8 @@ std::optional<std::string> validate(const FrontendConfig& c) {
   check.nested("motion_prior", validate(c.motion_prior));
   check.nested("icp", validate(c.icp));
   check.nested("handover", validate(c.handover));
-  check.nested("calibration", validate(c.calibration));
+  check.nested("calibration",
+               validate(static_cast<const calibration::ExtrinsicYawConfig&>(c.calibration)));
   if (check.problem()) return check.problem();
   // The searches' windows in cells of the level each runs on: the recovery search on the
   // coarsest, the wide search on level 1 (or 0 with one level).
