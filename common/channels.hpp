@@ -17,12 +17,6 @@ inline const std::string kPoseFrontend = "POSE_FRONTEND";    // pose2d_t, one pe
 inline const std::string kKeyPoses = "KEY_POSES";  // key_poses_t, backend key poses (incremental)
 inline const std::string kPoseGraphEdges =
     "POSE_GRAPH_EDGES";  // pose_graph_edges_t, backend graph edges (appended)
-inline const std::string kGraphRequest =
-    "GRAPH_REQUEST";  // graph_request_t, a late listener asks the backend for its whole graph
-inline const std::string kKeyPosesFull =
-    "KEY_POSES_FULL";  // key_poses_t, every key pose, the backend's answer to a GRAPH_REQUEST
-inline const std::string kPoseGraphEdgesFull =
-    "POSE_GRAPH_EDGES_FULL";  // pose_graph_edges_t, every edge, the answer to a GRAPH_REQUEST
 inline const std::string kAnnotations =
     "ANNOTATIONS";  // annotations_t, 95 % bounds, accuracy levels, colours
 inline const std::string kPoseBackend = "POSE_BACKEND";      // pose2d_t, each backend key pose once
@@ -39,7 +33,8 @@ inline const std::string kResendRequest =
 inline const std::string kLcmSelfTest = "LCM_SELF_TEST";
 
 // Where the whole state behind an incremental channel is published once more when a late
-// listener asks for it (resend_request_t on RESEND_REQUEST): <channel>_FULL, as KEY_POSES_FULL.
+// listener asks for it (resend_request_t on RESEND_REQUEST, common/resend.hpp): <channel>_FULL,
+// as KEY_POSES_FULL, with the incremental channel's type.
 std::string full_channel(const std::string& channel);
 
 // Every process publishes process_status_t once a second on STATUS_<NAME> (name upper-cased).

@@ -1,16 +1,20 @@
 #include "resend.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 
 #include "channels.hpp"
+#include "message_checks.hpp"
 #include "traverse/resend_request_t.hpp"
 
 namespace traverse {
 
 void request_resend(Publisher& bus, const std::string& requester,
-                    const std::vector<std::string>& wanted) {
+                    const std::vector<std::string>& wanted, int64_t utime) {
   resend_request_t m{};
-  m.requester = requester;
+  m.utime = utime;
+  m.requester = requester + "/" + std::to_string(::getpid());
   for (const std::string& c : wanted) {
     if (!c.empty()) m.channels.push_back(c);
   }
@@ -18,18 +22,52 @@ void request_resend(Publisher& bus, const std::string& requester,
   if (m.n_channels > 0) bus.publish(channels::kResendRequest, m);
 }
 
-void answer_resend_requests(Bus& bus, const std::string& channel,
-                            std::function<void(const std::string& requester)> answer) {
-  if (channel.empty()) return;
-  // Requesters are independent processes: their times need not be in order.
-  bus.subscribe<resend_request_t>(
-      channels::kResendRequest,
-      [channel, answer = std::move(answer)](const resend_request_t& m) {
-        if (std::find(m.channels.begin(), m.channels.end(), channel) != m.channels.end()) {
-          answer(m.requester);
-        }
-      },
-      true);
+ResendAnswerer::ResendAnswerer(Bus& bus, std::vector<std::string> channels, Answer answer)
+    : bus_(bus), channels_(std::move(channels)), answer_(std::move(answer)) {
+  std::erase(channels_, std::string());
+  if (channels_.empty()) return;
+  subscription_ = bus_.subscribe_raw(
+      channels::kResendRequest, [this](const std::string&, const uint8_t* data, int size, int64_t) {
+        on_request(data, size);
+      });
+}
+
+ResendAnswerer::~ResendAnswerer() {
+  if (subscription_) bus_.unsubscribe(subscription_);
+}
+
+void ResendAnswerer::on_request(const uint8_t* data, int size) {
+  resend_request_t m;
+  if (decode_checked(data, size, {}, m).verdict != MessageVerdict::kGood) {
+    ++counters_.rejected;
+    return;
+  }
+  ResendRequest r{m.requester, m.utime, {}};
+  for (const std::string& c : channels_) {
+    if (std::find(m.channels.begin(), m.channels.end(), c) != m.channels.end()) {
+      r.named.push_back(c);
+    }
+  }
+  if (r.named.empty()) return;  // for other producers
+  // Requesters are independent processes: only one requester's own numbers are in order.
+  auto [last, first] = last_seq_.try_emplace(m.requester, m.seq);
+  if (!first) {
+    if (m.seq <= last->second) {
+      ++counters_.repeated;
+      return;
+    }
+    last->second = m.seq;
+  }
+  ++counters_.requests;
+  if (answer_(r)) ++counters_.answers;
+}
+
+void ResendAnswerer::report(
+    const std::function<void(const std::string& name, double value)>& sink) const {
+  sink("resend_requests", static_cast<double>(counters_.requests));
+  sink("resend_answers", static_cast<double>(counters_.answers));
+  sink("resend_requests_repeated", static_cast<double>(counters_.repeated));
+  sink("resend_requests_rejected", static_cast<double>(counters_.rejected));
 }
 
 }  // namespace traverse

@@ -1,11 +1,22 @@
-// Late joining for what the graph publishes incrementally (the densifier's segments, the
-// annotator's annotations, the mapper's preview): a listener that starts after the graph has run
-// for a while asks once for the whole state behind the channels it reads (resend_request_t on
-// RESEND_REQUEST), and each producer answers for its own channel on <channel>_FULL with the same
-// type, so the listeners that were there from the start never see a second copy.
+// Late joining, the one mechanism of the graph: what a process publishes incrementally (the
+// backend's key poses and edges, the densifier's segments, the annotator's annotations, the
+// mapper's preview) cannot be rebuilt by a listener that starts after it, or that lost a message.
+// Such a listener asks once for the whole state behind the channels it reads (resend_request_t on
+// RESEND_REQUEST, one message naming every channel wanted), and each producer answers for its own
+// channels on <channel>_FULL with the same type, so the listeners that were there from the start
+// never see a second copy. Who asks: the annotator (KEY_POSES, POSE_GRAPH_EDGES), the mapper
+// (ANNOTATIONS), the viewer (CLOUD_PREVIEW, DENSE_SEGMENTS, ANNOTATIONS).
+//
+// Several processes ask on the one channel, so its sequence numbers interleave: the bus's
+// per-channel loss count would see gaps that are no loss. The answering side therefore reads the
+// requests itself (same layout checks as the bus) and keeps a sequence number per requester: a
+// request that is no newer than the last one heard from its requester (a datagram delivered twice)
+// is counted and dropped, as is one that does not decode.
 #pragma once
 
+#include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -13,14 +24,50 @@
 
 namespace traverse {
 
-// Asks once for the whole state of `wanted` (one message for all of them). Subscribe to
-// channels::full_channel(c) of each before asking: the answers may come at once.
+// Asks once for the whole state of `wanted` (one message for all of them; empty names are left
+// out); `utime` [us] is the newest data time the requester holds (0: none). Subscribe to
+// channels::full_channel(c) of each before asking: the answers may come at once. The request
+// names `requester` and this process's id, so a process restarted under the same name is a new
+// requester.
 void request_resend(Publisher& bus, const std::string& requester,
-                    const std::vector<std::string>& wanted);
+                    const std::vector<std::string>& wanted, int64_t utime = 0);
 
-// Calls answer(requester) for every resend request that names `channel`. An empty `channel`
-// (a producer configured not to publish it) answers nothing.
-void answer_resend_requests(Bus& bus, const std::string& channel,
-                            std::function<void(const std::string& requester)> answer);
+struct ResendRequest {
+  std::string requester;
+  int64_t utime = 0;               // [us] newest data time the requester holds (0: none)
+  std::vector<std::string> named;  // the answerer's channels that it names, in its order
+};
+
+// Answers the requests that name any of `channels` (empty names: channels not published, never
+// answered). The answer function returns whether it answered (a producer may decline: the backend
+// answers at most once per stretch of data time).
+class ResendAnswerer {
+ public:
+  using Answer = std::function<bool(const ResendRequest& request)>;
+  ResendAnswerer(Bus& bus, std::vector<std::string> channels, Answer answer);
+  ~ResendAnswerer();
+  ResendAnswerer(const ResendAnswerer&) = delete;
+  ResendAnswerer& operator=(const ResendAnswerer&) = delete;
+
+  struct Counters {
+    int64_t requests = 0;  // well-formed, new, naming one of the channels
+    int64_t answers = 0;   // of those, answered
+    int64_t repeated = 0;  // not newer than the last from the same requester: dropped
+    int64_t rejected = 0;  // did not decode: dropped
+  };
+  const Counters& counters() const { return counters_; }
+  // resend_requests, resend_answers, resend_requests_repeated, resend_requests_rejected.
+  void report(const std::function<void(const std::string& name, double value)>& sink) const;
+
+ private:
+  void on_request(const uint8_t* data, int size);
+
+  Bus& bus_;
+  std::vector<std::string> channels_;
+  Answer answer_;
+  Bus::Handle subscription_ = nullptr;
+  std::map<std::string, int64_t> last_seq_;  // by requester
+  Counters counters_;
+};
 
 }  // namespace traverse

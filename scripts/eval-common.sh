@@ -112,16 +112,20 @@ SENSOR_CHANNELS='SCAN_HORIZONTAL|SCAN_PROFILE|IMU|ODOMETRY|POSE_GROUND_TRUTH_3D'
 # CONFIG_SETS: "PROCESS.KEY=VALUE" items (eval-route.sh --set): KEY (dotted) set to VALUE (YAML) in
 # the config file configs/deploy/pipeline.yaml gives PROCESS. deployment_for OUTDIR writes the
 # changed configs (OUTDIR/PROCESS.yaml) and the deployment using them (OUTDIR/pipeline.yaml) and
-# prints its path; with no item, configs/deploy/pipeline.yaml itself.
+# prints its path; with no item, configs/deploy/pipeline.yaml itself. PLATFORM_SETS: items of the
+# same form that a script sets for the kind of input it evaluates, before the user's (the real
+# logs' scripts: what the deployment's configs set for the cart and a real log's platform does not
+# have).
 CONFIG_SETS=()
+PLATFORM_SETS=()
 deployment_for() {
   local out="$1" deploy="$ROOT/configs/deploy/pipeline.yaml" item process key value config
-  if ((${#CONFIG_SETS[@]} == 0)); then
+  if ((${#CONFIG_SETS[@]} + ${#PLATFORM_SETS[@]} == 0)); then
     echo "$deploy"
     return
   fi
   cp "$deploy" "$out/pipeline.yaml"
-  for item in "${CONFIG_SETS[@]}"; do
+  for item in "${PLATFORM_SETS[@]}" "${CONFIG_SETS[@]}"; do
     [[ $item =~ ^([A-Za-z0-9_-]+)\.([A-Za-z0-9_.]+)=(.*)$ ]] ||
       die "--set $item: expected PROCESS.KEY=VALUE, e.g. frontend.deskew.enabled=false"
     process="${BASH_REMATCH[1]}" key="${BASH_REMATCH[2]}" value="${BASH_REMATCH[3]}"

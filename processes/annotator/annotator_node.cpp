@@ -4,8 +4,6 @@
 #include <chrono>
 
 #include "config.hpp"
-#include "resend.hpp"
-#include "traverse/graph_request_t.hpp"
 
 namespace traverse::annotator {
 namespace {
@@ -97,32 +95,31 @@ AnnotatorNode::AnnotatorNode(Bus& bus, const AnnotatorNodeConfig& config, Counte
   bus_.subscribe<key_poses_t>(
       config_.key_poses_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
   // A late listener's answer: every annotation, as at the end of data but not final.
-  answer_resend_requests(bus_, config_.annotations_channel, [this](const std::string&) {
-    const std::vector<Annotation> all = all_annotations();
-    if (!all.empty()) {
-      publish(all, annotations_t::REASON_NEW, 0,
-              channels::full_channel(config_.annotations_channel));
-    }
-    ++resend_answers_;
-  });
-  if (config_.graph_request_channel.empty()) return;
-  // The backend's answers to a graph request: the whole graph, read like an update.
+  resend_ = std::make_unique<ResendAnswerer>(
+      bus_, std::vector<std::string>{config_.annotations_channel}, [this](const ResendRequest&) {
+        const std::vector<Annotation> all = all_annotations();
+        if (!all.empty()) {
+          publish(all, annotations_t::REASON_NEW, 0,
+                  channels::full_channel(config_.annotations_channel));
+        }
+        return true;
+      });
+  if (!config_.ask_for_state) return;
+  // The backend's answers: the whole graph, read like an update.
   bus_.subscribe<pose_graph_edges_t>(
-      channels::kPoseGraphEdgesFull, [this](const pose_graph_edges_t& m) { on_edges(m); }, true);
+      channels::full_channel(config_.edges_channel),
+      [this](const pose_graph_edges_t& m) { on_edges(m); }, true);
   bus_.subscribe<key_poses_t>(
-      channels::kKeyPosesFull, [this](const key_poses_t& m) { on_key_poses(m); }, true);
-  request_graph();  // a backend already running has a graph this node has not seen
+      channels::full_channel(config_.key_poses_channel),
+      [this](const key_poses_t& m) { on_key_poses(m); }, true);
+  ask_for_graph();  // a backend already running has a graph this node has not seen
 }
 
-void AnnotatorNode::request_graph() {
-  if (config_.graph_request_channel.empty() || requested_at_ == optimisation_) return;
-  graph_request_t m{};
-  m.utime = utime_;
-  m.edges_held = static_cast<int32_t>(annotator_.counters().edges);
-  m.key_poses_held = static_cast<int32_t>(annotator_.key_poses_held());
-  bus_.publish(config_.graph_request_channel, m);
+void AnnotatorNode::ask_for_graph() {
+  if (!config_.ask_for_state || requested_at_ == optimisation_) return;
+  request_resend(bus_, "annotator", {config_.edges_channel, config_.key_poses_channel}, utime_);
   requested_at_ = optimisation_;
-  ++graph_requests_;
+  ++resend_requests_sent_;
 }
 
 void AnnotatorNode::on_edges(const pose_graph_edges_t& msg) {
@@ -159,7 +156,7 @@ void AnnotatorNode::on_key_poses(const key_poses_t& msg) {
   // Something was missed (started late, or a message lost): ask for the whole graph.
   if (annotator_.key_poses_held() < static_cast<std::size_t>(graph_key_poses_) ||
       annotator_.counters().edges < graph_edges_) {
-    request_graph();
+    ask_for_graph();
   }
 }
 
@@ -200,8 +197,8 @@ void AnnotatorNode::report_counters() {
   counters_("updates", updates_);
   counters_("update_total_s", update_s_total_);
   counters_("update_max_s", update_s_max_);
-  counters_("graph_requests", graph_requests_);
-  counters_("resend_answers", resend_answers_);
+  counters_("resend_requests_sent", resend_requests_sent_);
+  resend_->report(counters_);
 }
 
 }  // namespace traverse::annotator

@@ -5,17 +5,18 @@
 // the end of data every annotation is sent once more (REASON_FINAL), so a late listener or the
 // recorded log's last word holds them all.
 //
-// Joining late: the backend's updates are incremental, so an annotator that starts after the
-// backend, or misses an edge or key pose message, holds part of the graph and can compute no
-// local bound. It asks for the whole graph (graph_request_t on graph_request_channel) when it
-// starts and after every optimisation that leaves it holding fewer key poses or edges than the
-// backend says the graph has; the backend answers on KEY_POSES_FULL and POSE_GRAPH_EDGES_FULL
-// (backend_node.hpp), which this node reads like the incremental channels. In turn, a listener
-// that started after the annotator (the viewer, the mapper) asks for every annotation
-// (resend_request_t naming ANNOTATIONS) and gets them on ANNOTATIONS_FULL.
+// Joining late (common/resend.hpp): the backend's updates are incremental, so an annotator that
+// starts after the backend, or misses an edge or key pose message, holds part of the graph and can
+// compute no local bound. It asks for the whole graph (resend_request_t naming KEY_POSES and
+// POSE_GRAPH_EDGES) when it starts and after every optimisation that leaves it holding fewer key
+// poses or edges than the backend says the graph has; the backend answers on KEY_POSES_FULL and
+// POSE_GRAPH_EDGES_FULL (backend_node.hpp), which this node reads like the incremental channels.
+// In turn, a listener that started after the annotator (the viewer, the mapper) asks for every
+// annotation (naming ANNOTATIONS) and gets them on ANNOTATIONS_FULL.
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@
 #include "annotator.hpp"
 #include "bus.hpp"
 #include "channels.hpp"
+#include "resend.hpp"
 #include "traverse/annotations_t.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/pose_graph_edges_t.hpp"
@@ -33,7 +35,7 @@ struct AnnotatorNodeConfig {
   std::string key_poses_channel = channels::kKeyPoses;
   std::string edges_channel = channels::kPoseGraphEdges;
   std::string annotations_channel = channels::kAnnotations;
-  std::string graph_request_channel = channels::kGraphRequest;  // "": never ask for the graph
+  bool ask_for_state = true;        // ask the backend for its whole graph when something is missing
   int max_keys_per_message = 1000;  // 52 bytes each: a part stays under 64 KB
   AnnotatorConfig annotator;        // its keys sit at the top level of the file
 
@@ -42,7 +44,7 @@ struct AnnotatorNodeConfig {
     v("key_poses_channel", key_poses_channel);
     v("edges_channel", edges_channel);
     v("annotations_channel", annotations_channel);
-    v("graph_request_channel", graph_request_channel);
+    v("ask_for_state", ask_for_state);
     v("max_keys_per_message", max_keys_per_message);
     annotator.visit(v);
   }
@@ -76,7 +78,7 @@ class AnnotatorNode {
                const std::string& channel);
   std::vector<Annotation> all_annotations() const;
   // Asks the backend for its whole graph (at most once per optimisation heard).
-  void request_graph();
+  void ask_for_graph();
 
   Bus& bus_;
   AnnotatorNodeConfig config_;
@@ -87,8 +89,9 @@ class AnnotatorNode {
   int32_t loop_closures_ = 0;  // loop closures in the graph
   bool closure_pending_ = false;
   int32_t graph_key_poses_ = 0, graph_edges_ = 0;  // the backend's graph, as its messages say
-  int32_t requested_at_ = -1;                      // optimisation of the last graph request
-  double graph_requests_ = 0, resend_answers_ = 0;
+  int32_t requested_at_ = -1;                      // optimisation of the last request
+  double resend_requests_sent_ = 0;
+  std::unique_ptr<ResendAnswerer> resend_;  // for ANNOTATIONS
   double messages_ = 0, updates_ = 0, update_s_total_ = 0, update_s_max_ = 0;
 };
 

@@ -38,6 +38,7 @@ std::optional<std::string> validate(const BackendConfig& c) {
   check.not_negative("frame_heading_sigma_rad", c.frame_heading_sigma_rad);
   check.not_negative("key_pose_sigma_xy_m", c.key_pose_sigma_xy_m);
   check.positive("marginal_scale", c.marginal_scale);
+  check.nested("boresight", validate(c.boresight));
   check.nested("odometry", validate(c.odometry));
   check.nested("loop", validate(c.loop));
   check.not_negative("closure_max_chi2_increase", c.closure_max_chi2_increase);
@@ -58,6 +59,7 @@ Backend::Backend(BackendConfig config)
       odometry_(config_.odometry),
       spa_(config_.spa),
       trial_spa_(config_.spa),
+      boresight_(config_.boresight),
       prep_(config_.smoothing) {}
 
 void Backend::add_scan(PlanarScan scan) {
@@ -111,14 +113,20 @@ std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
   return std::nullopt;
 }
 
+Pose2 Backend::published_pose(int i) const {
+  return boresight_.published(key_poses_[i].T_world_base, key_poses_[0].T_world_base);
+}
+
 Eigen::Matrix3d Backend::published_covariance(int i) const {
   if (i == 0) return Eigen::Matrix3d::Zero();
   // A turn of the frame by d rad about the first key pose moves key pose i by J d.
-  const Eigen::Vector2d r =
-      key_poses_[i].T_world_base.translation() - key_poses_[0].T_world_base.translation();
+  const Eigen::Vector2d r = published_pose(i).translation() - published_pose(0).translation();
   const Eigen::Vector3d J(-r.y(), r.x(), 1.0);
-  const double sf = config_.frame_heading_sigma_rad, sp = config_.key_pose_sigma_xy_m;
-  return config_.marginal_scale * key_poses_[i].covariance + sf * sf * J * J.transpose() +
+  const double sf =
+      boresight_.yaw_rad() ? boresight_.yaw_sigma_rad() : config_.frame_heading_sigma_rad;
+  const double sp = config_.key_pose_sigma_xy_m;
+  return config_.marginal_scale * boresight_.published(key_poses_[i].covariance) +
+         sf * sf * J * J.transpose() +
          Eigen::Vector3d(sp * sp, sp * sp, 0.0).asDiagonal().toDenseMatrix();
 }
 
@@ -321,10 +329,12 @@ std::optional<BackendUpdate> Backend::optimise() {
   const auto t1 = std::chrono::steady_clock::now();
   const auto marginals = spa_.marginals(graph_);
   update.marginals_s = seconds_since(t1);
+  std::vector<Pose2> poses(key_poses_.size());
   for (int i = 0; i < static_cast<int>(key_poses_.size()); ++i) {
-    key_poses_[i].T_world_base = graph_.poses[key_vertex(i)];
+    key_poses_[i].T_world_base = poses[i] = graph_.poses[key_vertex(i)];
     if (marginals) key_poses_[i].covariance = (*marginals)[key_vertex(i)];
   }
+  boresight_.update(poses);
   ++counters_.optimisations;
   // A graph of the fixed first key pose alone has nothing to optimise.
   if (key_poses_.size() > 1 && (!update.spa.converged || !marginals)) {

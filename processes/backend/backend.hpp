@@ -11,7 +11,9 @@
 //      motion with a penalty for straying from it (correlative_matcher.hpp);
 //   4. loops are closed with the best of all nearby current scans (loop_closer.hpp);
 //   5. the pose graph is optimised by Sparse Pose Adjustment (spa.hpp) and the marginal
-//      covariance of every key pose is recovered from its sparse Cholesky factor.
+//      covariance of every key pose is recovered from its sparse Cholesky factor;
+//   6. optionally, the horizontal scanner's boresight is estimated from the optimised key poses
+//      and the whole published trajectory is turned back by it (boresight.hpp).
 // Frontend poses are T_map_base (the frontend's map frame); key poses are T_world_base in the
 // backend's frame, which starts equal to the prepared frontend frame (first key pose fixed).
 #pragma once
@@ -23,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "boresight.hpp"
 #include "correlative_matcher.hpp"
 #include "loop_closer.hpp"
 #include "odometry_check.hpp"
@@ -92,7 +95,9 @@ struct BackendConfig {
   // boresight calibration (a rotation of the whole graph about the first key pose: the absolute
   // position error grows with the distance from there; relative poses keep none of it), and each
   // key pose's error against the moment it is stamped with (sensor clocks: the cart moves on
-  // while a stamp is late). 0: none.
+  // while a stamp is late). 0: none. While the boresight (below) is estimated and applied, the
+  // frame's heading errs by what the estimate errs: its standard deviation takes the place of
+  // frame_heading_sigma_rad.
   double frame_heading_sigma_rad = 0.0;  // [rad]
   double key_pose_sigma_xy_m = 0.0;      // [m]
   // The graph's marginals, and the information of the edges it publishes, are published this
@@ -101,6 +106,9 @@ struct BackendConfig {
   // does not move its optimum; the loop closer's check keeps the unscaled marginals, so nothing
   // the backend estimates changes with it.
   double marginal_scale = 1.0;  // [unitless]
+  // The horizontal scanner's yaw on the cart, estimated from the key poses and applied to every
+  // published key pose (boresight.hpp).
+  BoresightConfig boresight;
   // Wheel odometry, when there is any, as a check on each frontend step (odometry_check.hpp).
   OdometryCheckConfig odometry;
   LoopCloserConfig loop;
@@ -134,6 +142,7 @@ struct BackendConfig {
     v("frame_heading_sigma_rad", frame_heading_sigma_rad);
     v("key_pose_sigma_xy_m", key_pose_sigma_xy_m);
     v("marginal_scale", marginal_scale);
+    v("boresight", boresight);
     v("odometry", odometry);
     v("loop", loop);
     v("closure_max_chi2_increase", closure_max_chi2_increase);
@@ -235,11 +244,16 @@ class Backend {
   const std::vector<KeyEdge>& key_edges() const { return key_edges_; }
   const BackendConfig& config() const { return config_; }
   const std::vector<KeyPose>& key_poses() const { return key_poses_; }
+  // Key pose i as published: KeyPose::T_world_base (the graph's frame, in which the scans were
+  // matched) turned back by the scanner's boresight about the first key pose, when it is
+  // estimated (boresight.hpp); the same pose otherwise.
+  Pose2 published_pose(int i) const;
   // Key pose i's covariance as published: its marginal (KeyPose::covariance, which the loop
-  // closer's check uses) times marginal_scale, with the frame's heading and the key pose's own
-  // error of the config (frame_heading_sigma_rad, key_pose_sigma_xy_m). Zero for the first key
-  // pose.
+  // closer's check uses) times marginal_scale, with the frame's heading (frame_heading_sigma_rad,
+  // or the boresight estimate's standard deviation while it is applied) and the key pose's own
+  // error (key_pose_sigma_xy_m); in the published frame. Zero for the first key pose.
   Eigen::Matrix3d published_covariance(int i) const;
+  const Boresight& boresight() const { return boresight_; }
   const ScanStore& scans() const { return scans_; }
   const std::vector<LoopClosure>& closures() const { return closures_; }
   const LoopCloserCounters& loop_counters() const { return loop_.counters(); }
@@ -276,6 +290,7 @@ class Backend {
   OdometryCheck odometry_;
   SpaOptimizer spa_;
   SpaOptimizer trial_spa_;  // for the graph with a closure on trial
+  Boresight boresight_;     // fitted again at every optimisation
   BackendCounters counters_;
 
   TrajectoryPrep prep_;

@@ -51,33 +51,38 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
     bus_.subscribe<odometry_t>(config_.odometry_channel,
                                [this](const odometry_t& m) { on_odometry(m); });
   }
-  // Requests from several listeners interleave: their times need not be in order.
-  if (!config_.graph_request_channel.empty()) {
-    bus_.subscribe<graph_request_t>(
-        config_.graph_request_channel, [this](const graph_request_t& m) { on_graph_request(m); },
-        true);
-  }
+  resend_ = std::make_unique<ResendAnswerer>(
+      bus_, std::vector<std::string>{config_.edges_channel, config_.key_poses_channel},
+      [this](const ResendRequest& r) { return answer_resend(r); });
 }
 
-void BackendNode::on_graph_request(const graph_request_t&) {
-  ++graph_requests_;
+bool BackendNode::answer_resend(const ResendRequest& request) {
   // The graph as last published: key poses and edges added since wait for the next update.
   const std::size_t n_keys = published_.size();
   // An empty graph needs no answer: the listener gets all of it from the updates to come. A
   // request soon after an answer is dropped: the answer went to every listener, and one that
   // still lacks something asks again after the next optimisation.
-  if (n_keys == 0) return;
+  if (n_keys == 0) return false;
   const int64_t newest = backend_.key_poses()[n_keys - 1].utime;
-  if (graph_answers_ > 0 &&
-      newest - last_answer_utime_ < std::llround(config_.graph_resend_min_s * 1e6)) {
-    return;
+  const int64_t min_us = std::llround(config_.graph_resend_min_s * 1e6);
+  bool answered = false;
+  // Edges first, as with the updates: a listener that has them when the key poses come can
+  // compute its local bounds at once.
+  for (const std::string& channel : request.named) {
+    auto last = last_answer_utime_.find(channel);
+    if (last != last_answer_utime_.end() && newest - last->second < min_us) continue;
+    if (channel == config_.edges_channel) {
+      publish_edges(0, edges_published_, last_update_.optimisation,
+                    channels::full_channel(channel));
+    } else {
+      std::vector<int> all(n_keys);
+      std::iota(all.begin(), all.end(), 0);
+      publish_key_poses(all, n_keys, last_update_, channels::full_channel(channel));
+    }
+    last_answer_utime_[channel] = newest;
+    answered = true;
   }
-  std::vector<int> all(n_keys);
-  std::iota(all.begin(), all.end(), 0);
-  publish_edges(0, edges_published_, last_update_.optimisation, channels::kPoseGraphEdgesFull);
-  publish_key_poses(all, n_keys, last_update_, channels::kKeyPosesFull);
-  last_answer_utime_ = newest;
-  ++graph_answers_;
+  return answered;
 }
 
 void BackendNode::on_odometry(const odometry_t& msg) {
@@ -104,7 +109,7 @@ void BackendNode::finish() {
 bool BackendNode::changed(int i) const {
   if (i >= static_cast<int>(published_.size())) return true;
   const Published& p = published_[i];
-  const Pose2& T = backend_.key_poses()[i].T_world_base;
+  const Pose2 T = backend_.published_pose(i);
   if ((T.translation() - p.T_world_base.translation()).norm() > config_.publish_move_m) return true;
   if (std::abs(wrap_angle(T.theta() - p.T_world_base.theta())) > config_.publish_turn_rad) {
     return true;
@@ -169,7 +174,7 @@ void BackendNode::publish(const BackendUpdate& update) {
   }
   published_.resize(keys.size());
   for (int i : changed_ids) {
-    published_[i] = {keys[i].T_world_base, backend_.published_covariance(i).diagonal()};
+    published_[i] = {backend_.published_pose(i), backend_.published_covariance(i).diagonal()};
   }
   publish_key_poses(changed_ids, keys.size(), update, config_.key_poses_channel);
   last_update_ = update;
@@ -182,9 +187,10 @@ void BackendNode::publish(const BackendUpdate& update) {
     pose.utime = keys[i].utime;
     pose.parent_frame = "map";  // the frontend's frame, which the graph keeps
     pose.child_frame = "base";
-    pose.x = keys[i].T_world_base.x();
-    pose.y = keys[i].T_world_base.y();
-    pose.theta = keys[i].T_world_base.theta();
+    const Pose2 T = backend_.published_pose(i);
+    pose.x = T.x();
+    pose.y = T.y();
+    pose.theta = T.theta();
     copy_matrix(backend_.published_covariance(i), pose.covariance);
     pose.flags = pose2d_t::FLAG_KEY_POSE;
     bus_.publish(config_.trajectory_channel, pose);
@@ -215,9 +221,10 @@ void BackendNode::publish_key_poses(const std::vector<int>& ids, std::size_t n_k
       key_pose_t p{};
       p.utime = keys[i].utime;
       p.id = i;
-      p.x = keys[i].T_world_base.x();
-      p.y = keys[i].T_world_base.y();
-      p.theta = keys[i].T_world_base.theta();
+      const Pose2 T = backend_.published_pose(i);
+      p.x = T.x();
+      p.y = T.y();
+      p.theta = T.theta();
       copy_matrix(backend_.published_covariance(i), p.covariance);
       msg.poses.push_back(p);
     }
@@ -287,8 +294,11 @@ void BackendNode::report_counters() {
   counters_("scan_bytes_per_key_pose", backend_.scans().bytes_per_key_pose());
   counters_("key_poses_messages", static_cast<double>(messages_));
   counters_("key_poses_message_max_bytes", static_cast<double>(max_message_bytes_));
-  counters_("graph_requests", static_cast<double>(graph_requests_));
-  counters_("graph_answers", static_cast<double>(graph_answers_));
+  resend_->report(counters_);
+  counters_("boresight_yaw_rad", backend_.boresight().yaw_rad().value_or(0.0));
+  counters_("boresight_estimate_rad", backend_.boresight().estimate_rad());
+  counters_("boresight_yaw_sigma_rad", backend_.boresight().yaw_sigma_rad());
+  counters_("boresight_chords", static_cast<double>(backend_.boresight().chords()));
   if (!state_) return;
   const BackendStateCounters& s = state_->counters();
   counters_("state_snapshots", static_cast<double>(s.snapshots));

@@ -6,17 +6,20 @@
 // (pose_graph_edges_t, in parts of at most max_poses_per_message edges).
 //
 // A listener that starts after the backend, or misses a message, holds an incomplete graph: the
-// updates are incremental. It asks for the whole graph with a graph_request_t on GRAPH_REQUEST,
-// and the node publishes every edge on POSE_GRAPH_EDGES_FULL and every key pose on KEY_POSES_FULL
-// (same types and parts as the incremental channels, no loop closures listed): separate channels,
-// so that listeners that only follow updates (the densifier, which would re-send every segment)
-// never see the repeat. At most one answer per graph_resend_min_s of data time (the newest key
+// updates are incremental. It asks for the whole graph the graph's one way (common/resend.hpp): a
+// resend_request_t on RESEND_REQUEST naming KEY_POSES and/or POSE_GRAPH_EDGES. The node answers
+// with every edge on POSE_GRAPH_EDGES_FULL and every key pose on KEY_POSES_FULL (same types and
+// parts as the incremental channels, no loop closures listed): separate channels, so that
+// listeners that only follow updates (the densifier, which would re-send every segment) never see
+// the repeat. At most one answer per channel per graph_resend_min_s of data time (the newest key
 // pose's time, so a replay answers the same way as the live run): a request inside that stretch
 // is dropped, the answer having gone to every listener; one that still lacks something asks again
 // after the next optimisation.
 #pragma once
 
 #include <functional>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,7 +28,7 @@
 #include "backend_state.hpp"
 #include "bus.hpp"
 #include "channels.hpp"
-#include "traverse/graph_request_t.hpp"
+#include "resend.hpp"
 #include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -39,8 +42,7 @@ struct BackendNodeConfig {
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
   std::string edges_channel = channels::kPoseGraphEdges;
-  std::string graph_request_channel = channels::kGraphRequest;  // "": never resend the graph
-  double graph_resend_min_s = 5.0;   // [s] of data time between two answers to graph requests
+  double graph_resend_min_s = 5.0;   // [s] of data time between two answers on a _FULL channel
   int max_poses_per_message = 400;   // 112 bytes each: 400 keep a part under 64 KB
   double publish_move_m = 0.001;     // a key pose moved farther than this is republished [m]
   double publish_turn_rad = 0.0005;  // ... or turned more than this [rad]
@@ -61,7 +63,6 @@ struct BackendNodeConfig {
     v("key_poses_channel", key_poses_channel);
     v("trajectory_channel", trajectory_channel);
     v("edges_channel", edges_channel);
-    v("graph_request_channel", graph_request_channel);
     v("graph_resend_min_s", graph_resend_min_s);
     v("max_poses_per_message", max_poses_per_message);
     v("publish_move_m", publish_move_m);
@@ -100,7 +101,8 @@ class BackendNode {
   void on_scan(const planar_scan_t& msg);
   void on_pose(const pose2d_t& msg);
   void on_odometry(const odometry_t& msg);
-  void on_graph_request(const graph_request_t& msg);
+  // A late listener's request (resend.hpp); true when it was answered.
+  bool answer_resend(const ResendRequest& request);
   void publish(const BackendUpdate& update);
   // Edges [first, last) on `channel`.
   void publish_edges(std::size_t first, std::size_t last, int32_t optimisation,
@@ -123,9 +125,9 @@ class BackendNode {
   std::size_t max_message_bytes_ = 0;
   long messages_ = 0;
   std::size_t edges_published_ = 0;
-  BackendUpdate last_update_;      // optimisation counter and time of the newest update
-  int64_t last_answer_utime_ = 0;  // [us] newest key pose time at the last answer
-  long graph_requests_ = 0, graph_answers_ = 0;
+  BackendUpdate last_update_;  // optimisation counter and time of the newest update
+  std::map<std::string, int64_t> last_answer_utime_;  // [us] newest key pose time, by channel
+  std::unique_ptr<ResendAnswerer> resend_;
   std::optional<BackendStateStore> state_;
   std::optional<ResumedState> resumed_;
 };

@@ -3,7 +3,6 @@
 #include <algorithm>
 
 #include "channels.hpp"
-#include "resend.hpp"
 
 namespace traverse::densifier {
 
@@ -61,10 +60,11 @@ DensifierNode::DensifierNode(Bus& bus, const DensifierConfig& config, CounterSin
   bus_.subscribe<pose2d_t>(channels::kPoseFrontend, [this](const pose2d_t& m) { on_frontend(m); });
   bus_.subscribe<key_poses_t>(
       config_.key_pose_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
-  answer_resend_requests(bus_, channels::kDenseSegments, [this](const std::string&) {
-    publish(densifier_.sent_segments(), channels::full_channel(channels::kDenseSegments));
-    ++resend_answers_;
-  });
+  resend_ = std::make_unique<ResendAnswerer>(
+      bus_, std::vector<std::string>{channels::kDenseSegments}, [this](const ResendRequest&) {
+        publish(densifier_.sent_segments(), channels::full_channel(channels::kDenseSegments));
+        return true;
+      });
 }
 
 void DensifierNode::on_frontend(const pose2d_t& msg) {
@@ -125,7 +125,7 @@ void DensifierNode::report_counters() {
   counters_("segments_moved", static_cast<double>(densifier_.segments_moved()));
   counters_("spikes_replaced", static_cast<double>(densifier_.spikes_replaced()));
   counters_("dense_rejected", dense_rejected_);
-  counters_("resend_answers", resend_answers_);
+  resend_->report(counters_);
 }
 
 }  // namespace traverse::densifier

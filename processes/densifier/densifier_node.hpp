@@ -6,15 +6,17 @@
 // grows), and the new or moved segments whole on DENSE_SEGMENTS (dense_segments_t), packed many to
 // a message of at most `max_message_bytes`: after a loop closure hundreds of segments move at
 // once, and one small datagram each overflowed the listeners' receive buffers. A listener that
-// started late (the viewer) asks for every segment (resend_request_t naming DENSE_SEGMENTS), and
-// gets them on DENSE_SEGMENTS_FULL, the newest revision of each.
+// started late (the viewer) asks for every segment (common/resend.hpp: resend_request_t naming
+// DENSE_SEGMENTS), and gets them on DENSE_SEGMENTS_FULL, the newest revision of each.
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "bus.hpp"
 #include "densifier.hpp"
+#include "resend.hpp"
 #include "traverse/dense_segments_t.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -51,7 +53,8 @@ class DensifierNode {
   int64_t newest_frontend_utime_ = 0;  // [us] utime of DENSE_SEGMENTS: never goes backwards
   int32_t optimisation_ = 0;           // newest backend optimisation seen on KEY_POSES
   double segments_published_ = 0, segment_messages_ = 0, oversize_messages_ = 0;
-  double dense_rejected_ = 0, resend_answers_ = 0;
+  double dense_rejected_ = 0;
+  std::unique_ptr<ResendAnswerer> resend_;  // for DENSE_SEGMENTS
 };
 
 }  // namespace traverse::densifier

@@ -8,6 +8,7 @@
 #include "icp/icp_frontend.hpp"
 #include "sparse/ensemble.hpp"
 #include "sparse/lag.hpp"
+#include "sparse/widen.hpp"
 #include "two_phase.hpp"
 
 namespace traverse::frontend {
@@ -22,7 +23,9 @@ std::unique_ptr<Frontend> make_hector(const FrontendConfig& config) {
     c.initial_pose = {.x_m = T_map_base_initial.x(),
                       .y_m = T_map_base_initial.y(),
                       .theta_rad = T_map_base_initial.theta()};
-    auto hector = std::make_unique<HectorFrontend>(c);
+    std::unique_ptr<TwoPhaseFrontend> hector = std::make_unique<HectorFrontend>(c);
+    if (c.matcher.sparse_widen_evidence_ratio > 0.0)
+      hector = std::make_unique<SparseWiden>(std::move(hector), c.matcher);
     if (c.matcher.sparse_lag) return std::make_unique<SparseLag>(std::move(hector), c.matcher);
     return std::make_unique<MeasureAndIntegrate>(std::move(hector));
   };

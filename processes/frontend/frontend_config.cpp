@@ -61,6 +61,9 @@ std::optional<std::string> validate(const MatcherConfig& c) {
                 "sparse_lag_window_rad", "must be in (0, pi]");
   check.not_negative("sparse_lag_long_weight", c.sparse_lag_long_weight);
   check.not_negative("sparse_lag_margin", c.sparse_lag_margin);
+  check.in_range("sparse_widen_evidence_ratio", c.sparse_widen_evidence_ratio, 0.0, 1.0);
+  check.require(c.sparse_widen_factor > 1.0, "sparse_widen_factor", "must be above 1");
+  check.positive("sparse_widen_max_window_m", c.sparse_widen_max_window_m);
   check.in_range("degeneracy_min_ratio", c.degeneracy_min_ratio, 0.0, 1.0);
   check.in_range("moved_max_probability", c.moved_max_probability, 0.0, 0.5);
   return check.problem();
@@ -98,14 +101,6 @@ std::optional<std::string> validate(const MotionPriorConfig& c) {
   return check.problem();
 }
 
-std::optional<std::string> validate(const CalibrationConfig& c) {
-  ConfigCheck check;
-  check.in_range("chord_m", c.chord_m, 0.05, 100.0);
-  check.in_range("min_travel_m", c.min_travel_m, 0.0, 1e6);
-  check.in_range("max_yaw_rad", c.max_yaw_rad, 0.0, 0.5);
-  return check.problem();
-}
-
 std::optional<std::string> validate(const FrontendConfig& c) {
   ConfigCheck check;
   check.require(c.kind == "hector" || c.kind == "icp", "kind",
@@ -122,7 +117,8 @@ std::optional<std::string> validate(const FrontendConfig& c) {
   check.nested("motion_prior", validate(c.motion_prior));
   check.nested("icp", validate(c.icp));
   check.nested("handover", validate(c.handover));
-  check.nested("calibration", validate(c.calibration));
+  check.nested("calibration",
+               validate(static_cast<const calibration::ExtrinsicYawConfig&>(c.calibration)));
   if (check.problem()) return check.problem();
   // The searches' windows in cells of the level each runs on: the recovery search on the
   // coarsest, the wide search on level 1 (or 0 with one level).

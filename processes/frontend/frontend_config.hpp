@@ -7,6 +7,7 @@
 #include <string>
 
 #include "channels.hpp"
+#include "extrinsic_yaw.hpp"
 #include "handover_config.hpp"
 #include "icp/icp_config.hpp"
 #include "pose_config.hpp"
@@ -160,6 +161,15 @@ struct MatcherConfig {
   double sparse_lag_window_rad = 0.2;
   double sparse_lag_long_weight = 0.2;  // [per point]
   double sparse_lag_margin = 0.1;       // [per point, evidence -1 to 1]
+  // Sparse widening (sparse/widen.hpp): a sparse scan (without odometry) whose match fits worse
+  // than sparse_widen_evidence_ratio times the median evidence of the last sparse matches is
+  // searched again in windows sparse_widen_factor times wider, up to sparse_widen_max_window_m
+  // (+- in x and y), and moved where a wider window fits it as well as usual and sparse_lag_margin
+  // per point better than before. A step of 3 m where the log usually steps 0.6 m
+  // (tests/carmen/long_step_test.cpp). 0 for the ratio turns it off.
+  double sparse_widen_evidence_ratio = 0.7;
+  double sparse_widen_factor = 2.0;
+  double sparse_widen_max_window_m = 8.0;  // [m]
 
   template <class V>
   void visit(V& v) {
@@ -195,6 +205,9 @@ struct MatcherConfig {
     v("sparse_lag_window_rad", sparse_lag_window_rad);
     v("sparse_lag_long_weight", sparse_lag_long_weight);
     v("sparse_lag_margin", sparse_lag_margin);
+    v("sparse_widen_evidence_ratio", sparse_widen_evidence_ratio);
+    v("sparse_widen_factor", sparse_widen_factor);
+    v("sparse_widen_max_window_m", sparse_widen_max_window_m);
   }
 };
 
@@ -295,24 +308,22 @@ struct MotionPriorConfig {
 
 // Calibration of the rig while it runs (calibration/): the horizontal scanner's yaw in the base
 // frame, from the constraint that a wheeled base moves along its own x axis
-// (calibration/extrinsic_yaw.hpp). The poses come out in the frame of the base the rig file
+// (common/extrinsic_yaw.hpp). The poses come out in the frame of the base the rig file
 // meant, the map's frame the base at the first scan (initial_pose); odometry is turned into the
 // frame the scans are matched in.
-struct CalibrationConfig {
-  // Estimate and apply the yaw. Off by default: on the relations log intel it made the frontend's
-  // mean translational error 0.099 m against 0.021 m without (the estimate turns the path about its
-  // start); never on a platform that may move sideways (hand-held, omni wheels).
+struct CalibrationConfig : calibration::ExtrinsicYawConfig {
+  // Estimate and apply the yaw as each pose comes. Off by default: on the relations log intel it
+  // made the frontend's mean translational error 0.099 m against 0.021 m without (the estimate
+  // turns each new pose about the start by the estimate of the moment, so poses published while
+  // it converges disagree with each other); the backend applies one estimate to the whole
+  // trajectory instead (processes/backend/boresight.hpp). Never on a platform that may move
+  // sideways (hand-held, omni wheels).
   bool extrinsic_yaw = false;
-  double chord_m = 1.0;        // [m] path chords the fit takes
-  double min_travel_m = 10.0;  // [m] of chords before the estimate is applied
-  double max_yaw_rad = 0.035;  // [rad] (2 deg) a larger estimate is not applied: fix the rig file
 
   template <class V>
   void visit(V& v) {
     v("extrinsic_yaw", extrinsic_yaw);
-    v("chord_m", chord_m);
-    v("min_travel_m", min_travel_m);
-    v("max_yaw_rad", max_yaw_rad);
+    calibration::ExtrinsicYawConfig::visit(v);
   }
 };
 
@@ -362,7 +373,6 @@ std::optional<std::string> validate(const MapConfig& config);
 std::optional<std::string> validate(const MatcherConfig& config);
 std::optional<std::string> validate(const DeskewConfig& config);
 std::optional<std::string> validate(const MotionPriorConfig& config);
-std::optional<std::string> validate(const CalibrationConfig& config);
 std::optional<std::string> validate(const FrontendConfig& config);
 
 }  // namespace traverse::frontend

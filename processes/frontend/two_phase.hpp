@@ -26,6 +26,9 @@ struct Measurement {
   bool subsampled_by_travel = false;
   // Wheel odometry's step from the pose before to this scan, where the prediction took it.
   std::optional<Pose2> odometry_step;
+  // A step the data show is long: its length [m], where a search wider than the wide search's
+  // window found the scan (sparse/widen.hpp). The lag does not count a step up to it as long.
+  std::optional<double> long_step_m;
 };
 
 // Where to match a measurement again: around T_centre, within +-linear_window_m in x and y and

@@ -6,10 +6,8 @@
 #include <chrono>
 #include <cstdio>
 
-#include "config.hpp"
+#include "bench_sim.hpp"
 #include "json.hpp"
-#include "mapper.hpp"
-#include "simulator.hpp"
 #include "version.hpp"
 
 namespace {
@@ -45,36 +43,21 @@ int main(int argc, char** argv) {
   traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
-  ts::WorldSpec world;
-  ts::RouteSpec route;
-  ts::RigConfig rig;
-  traverse::load_config(world_file, world);
-  traverse::load_config(route_file, route);
-  traverse::load_config(rig_file, rig);
   ts::RunOptions opt;
   opt.begin_s = begin_s;
   opt.duration_s = duration_s;
-  ts::Simulator sim(world, route, rig, ts::PlatformConfig{}, 1, 1'700'000'000'000'000, opt);
+  tm::BenchSim bench(world_file, route_file, rig_file, opt);
+  const ts::RigConfig& rig = bench.rig;
   std::vector<tm::Profile> profiles;
   std::vector<int64_t> gt_t;
   std::vector<traverse::Pose2> gt;
   const auto t_sim = Clock::now();
-  while (auto e = sim.next()) {
+  while (auto e = bench.simulator->next()) {
     if (e->kind == ts::SimEvent::Kind::kGroundTruth) {
       gt_t.push_back(e->utime);
       gt.push_back(e->ground_truth.T_world_base);
     } else if (e->kind == ts::SimEvent::Kind::kScanProfile) {
-      const ts::ScanData& s = e->scan;
-      tm::Profile p;
-      p.utime_first = s.utime_first;
-      p.utime_last = s.utime_last;
-      p.angle_first = s.angle_first;
-      p.angle_step = s.angle_step;
-      p.range_min = s.range_min;
-      p.range_max = s.range_max;
-      p.ranges = s.ranges;
-      p.intensities = s.intensities;
-      profiles.push_back(std::move(p));
+      profiles.push_back(tm::profile_of(e->scan));
     }
   }
   std::fprintf(stderr, "simulated %.0f s: %zu profiles, %zu true poses in %.1f s\n", duration_s,

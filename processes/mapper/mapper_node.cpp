@@ -42,13 +42,16 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
         channels::full_channel(config_.annotations_channel),
         [this](const annotations_t& m) { on_annotations(m); }, true);
     request_resend(bus, "mapper", {config_.annotations_channel});
+    ++resend_requests_sent_;
   }
   if (preview_) {
-    answer_resend_requests(bus, config_.preview.channel, [this](const std::string&) {
-      resend_next_ = 0;  // from the start, paced by publish_preview()
-      ++resend_answers_;
-    });
-    resend_next_ = preview_sent_.size();
+    resend_store_ =
+        std::make_unique<PreviewResend>(config_.preview.cell_m, config_.preview.resend_max_bytes);
+    resend_ = std::make_unique<ResendAnswerer>(
+        bus, std::vector<std::string>{config_.preview.channel}, [this](const ResendRequest&) {
+          resend_store_->restart();  // from the start, paced by publish_preview()
+          return true;
+        });
   }
   if (worker_thread) worker_ = std::thread([this] { run_worker(); });
 }
@@ -255,30 +258,38 @@ bool MapperNode::export_all(std::string* error) {
   return true;
 }
 
+namespace {
+
+cloud_preview_t preview_message(const std::vector<PreviewProfile>& profiles, double cell_m) {
+  cloud_preview_t m{};
+  m.parent_frame = "map";
+  m.cell_m = cell_m;
+  for (const PreviewProfile& p : profiles) {
+    preview_profile_t e{};
+    e.utime = p.utime;
+    e.n_points = static_cast<int32_t>(p.p_base_mm.size());
+    for (const auto& q : p.p_base_mm) {
+      e.x_mm.push_back(q[0]);
+      e.y_mm.push_back(q[1]);
+      e.z_mm.push_back(q[2]);
+    }
+    m.utime = std::max(m.utime, p.utime);
+    m.profiles.push_back(std::move(e));
+  }
+  m.n_profiles = static_cast<int32_t>(m.profiles.size());
+  return m;
+}
+
+}  // namespace
+
 void MapperNode::publish_preview() {
   if (!preview_) return;
   for (const std::vector<PreviewProfile>& group : preview_->take()) {
-    cloud_preview_t m{};
-    m.parent_frame = "map";
-    m.cell_m = config_.preview.cell_m;
-    for (const PreviewProfile& p : group) {
-      preview_profile_t e{};
-      e.utime = p.utime;
-      e.n_points = static_cast<int32_t>(p.p_base_mm.size());
-      for (const auto& q : p.p_base_mm) {
-        e.x_mm.push_back(q[0]);
-        e.y_mm.push_back(q[1]);
-        e.z_mm.push_back(q[2]);
-      }
-      m.utime = std::max(m.utime, p.utime);
-      m.profiles.push_back(std::move(e));
-    }
-    m.n_profiles = static_cast<int32_t>(m.profiles.size());
+    cloud_preview_t m = preview_message(group, config_.preview.cell_m);
     bus_.publish(config_.preview.channel, m);
     ++preview_messages_;
-    const bool resend_done = resend_next_ == preview_sent_.size();
-    preview_sent_.push_back(std::move(m));
-    if (resend_done) resend_next_ = preview_sent_.size();  // a late viewer just got this one
+    preview_sent_bytes_ += m.getEncodedSize();
+    for (const PreviewProfile& p : group) resend_store_->add(p);
   }
   // A late viewer's answer, at most kResendBytes per kResendWindow: a whole route's preview is
   // tens of MB, and on LCM's multicast every process of the graph receives every message, so at
@@ -291,8 +302,10 @@ void MapperNode::publish_preview() {
     resend_window_bytes_ = 0;
   }
   const std::string full = channels::full_channel(config_.preview.channel);
-  while (resend_next_ < preview_sent_.size() && resend_window_bytes_ < kResendBytes) {
-    cloud_preview_t& m = preview_sent_[resend_next_++];
+  const auto per = static_cast<std::size_t>(config_.preview.max_points_per_message);
+  while (resend_store_->resending() && resend_window_bytes_ < kResendBytes) {
+    cloud_preview_t m = preview_message(resend_store_->next(per), resend_store_->cell_m());
+    if (m.n_profiles == 0) break;
     resend_window_bytes_ += static_cast<std::size_t>(m.getEncodedSize());
     bus_.publish(full, m);
     ++resend_messages_;
@@ -314,6 +327,7 @@ void MapperNode::report_counters() {
   counters_("profiles", s.profiles);
   counters_("annotated_key_poses", static_cast<double>(colours_.size()));
   counters_("annotation_level_changes", level_changes_);
+  counters_("resend_requests_sent", resend_requests_sent_);
   counters_("voxels_coloured", static_cast<double>(voxel_colours_.voxels));
   counters_("voxels_annotated", static_cast<double>(voxel_colours_.annotated));
   counters_("profiles_pending", s.pending);
@@ -345,8 +359,17 @@ void MapperNode::report_counters() {
   if (preview_) {
     counters_("preview_points", static_cast<double>(preview_->points()));
     counters_("preview_messages", preview_messages_);
-    counters_("resend_answers", resend_answers_);
+    counters_("preview_sent_bytes", preview_sent_bytes_);
+    resend_->report(counters_);
     counters_("resend_messages", resend_messages_);
+    const PreviewResendCounters& r = resend_store_->counters();
+    counters_("preview_resend_points", static_cast<double>(resend_store_->points()));
+    counters_("preview_resend_profiles", static_cast<double>(resend_store_->profiles()));
+    counters_("preview_resend_bytes", static_cast<double>(resend_store_->bytes()));
+    counters_("preview_resend_cell_m", resend_store_->cell_m());
+    counters_("preview_resend_compactions", static_cast<double>(r.compactions));
+    counters_("preview_resend_points_compacted", static_cast<double>(r.points_compacted));
+    counters_("preview_resend_compact_max_s", r.compact_max_s);
   }
 }
 

@@ -11,12 +11,14 @@
 // (cloud_preview_t on CLOUD_PREVIEW, preview.hpp) for the operator's viewer, published from the
 // process's own thread (publish_preview()).
 //
-// Late listeners: every preview message sent is kept (about 6 bytes a point), and a viewer that
-// starts after the mapper asks for them (resend_request_t naming CLOUD_PREVIEW) and gets them
-// again on CLOUD_PREVIEW_FULL, paced by publish_preview() (640 KB/s) so as not to overflow the
-// sockets of the viewer or of the other processes, which receive every multicast message. In
-// turn the node asks the annotator for every annotation when it starts (ANNOTATIONS_FULL), so a
-// mapper started after the annotator colours its points at once, not grey until the end of data.
+// Late listeners (common/resend.hpp): a viewer that starts after the mapper asks for the preview
+// (resend_request_t naming CLOUD_PREVIEW) and gets it again on CLOUD_PREVIEW_FULL, paced by
+// publish_preview() (640 KB/s) so as not to overflow the sockets of the viewer or of the other
+// processes, which receive every multicast message. What is kept for that is capped
+// (preview.resend_max_bytes) and thinned to a coarser grid beyond the cap (preview_resend.hpp), so
+// it follows the map, not the run. In turn the node asks the annotator for every annotation when
+// it starts (ANNOTATIONS_FULL), so a mapper started after the annotator colours its points at
+// once, not grey until the end of data.
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
@@ -50,6 +52,8 @@
 #include "bus.hpp"
 #include "mapper.hpp"
 #include "mapper_state.hpp"
+#include "preview_resend.hpp"
+#include "resend.hpp"
 #include "traverse/annotations_t.hpp"
 #include "traverse/cloud_preview_t.hpp"
 #include "traverse/dense_segments_t.hpp"
@@ -122,14 +126,14 @@ class MapperNode {
   MapperConfig config_;
   Mapper mapper_;                          // touched only by the worker (or inline)
   std::unique_ptr<CloudPreview> preview_;  // filled by the worker, published by publish_preview
-  double preview_messages_ = 0;
-  // Every preview message sent, for a late viewer; the next to send again (none when at the end),
-  // and how many bytes went out in the current pacing window.
-  std::vector<cloud_preview_t> preview_sent_;
-  std::size_t resend_next_ = 0;
+  double preview_messages_ = 0, preview_sent_bytes_ = 0;
+  // What a late viewer is sent (this thread only), and how many bytes of the answer went out in
+  // the current pacing window.
+  std::unique_ptr<PreviewResend> resend_store_;
+  std::unique_ptr<ResendAnswerer> resend_;
   std::chrono::steady_clock::time_point resend_window_;
   std::size_t resend_window_bytes_ = 0;
-  double resend_answers_ = 0, resend_messages_ = 0;
+  double resend_messages_ = 0;
   CounterSink counters_;
   // Handler side (LCM thread).
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first
@@ -137,7 +141,7 @@ class MapperNode {
   TrajectorySegment open_;           // pose2d_t stream: poses since the last cut
   PointColours colours_;             // the annotations, by key pose (this thread only)
   VoxelColourCounts voxel_colours_;  // of the last export (this thread only)
-  double level_changes_ = 0;
+  double level_changes_ = 0, resend_requests_sent_ = 0;
   int64_t next_key_id_ = 0;
   std::unique_ptr<MapperStateStore> state_;  // written on this thread
   std::optional<Resumed> resumed_;

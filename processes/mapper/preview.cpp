@@ -12,29 +12,36 @@ std::optional<std::string> validate(const PreviewConfig& c) {
   // 21 bits per axis: 2^20 cells either side of the origin.
   check.in_range("cell_m", c.cell_m, 0.001, 100.0);
   check.in_range("max_points_per_message", c.max_points_per_message, 1, 10000);
+  check.in_range("resend_max_bytes", c.resend_max_bytes, int64_t{1} << 10, int64_t{1} << 40);
   return check.problem();
+}
+
+std::optional<uint64_t> preview_cell(double x, double y, double z, double cell_m) {
+  constexpr double kHalf = 1 << 20;  // cell index offset: 21 bits per axis
+  const double ix = std::floor(x / cell_m) + kHalf;
+  const double iy = std::floor(y / cell_m) + kHalf;
+  const double iz = std::floor(z / cell_m) + kHalf;
+  if (!(ix >= 0 && ix < 2 * kHalf && iy >= 0 && iy < 2 * kHalf && iz >= 0 && iz < 2 * kHalf)) {
+    return std::nullopt;
+  }
+  return static_cast<uint64_t>(ix) | static_cast<uint64_t>(iy) << 21 |
+         static_cast<uint64_t>(iz) << 42;
 }
 
 CloudPreview::CloudPreview(const PreviewConfig& config) : config_(config) {}
 
 void CloudPreview::add(int64_t utime, const Pose2& T_world_base,
                        const std::vector<Eigen::Vector3f>& p_world) {
-  constexpr double kHalf = 1 << 20;  // cell index offset: 21 bits per axis
   const double c = std::cos(T_world_base.theta()), s = std::sin(T_world_base.theta());
-  PreviewProfile out{utime, {}};
+  PreviewProfile out{utime, {}, T_world_base};
   std::lock_guard lock(mutex_);
   // Neighbouring beams are millimetres apart: most fall in the cell the one before fell in, which
   // is then known to be taken without asking the set (a lookup per point cost the mapper 20 %).
   uint64_t previous = ~uint64_t{0};
   for (const Eigen::Vector3f& p : p_world) {
-    const double ix = std::floor(p.x() / config_.cell_m) + kHalf;
-    const double iy = std::floor(p.y() / config_.cell_m) + kHalf;
-    const double iz = std::floor(p.z() / config_.cell_m) + kHalf;
-    if (!(ix >= 0 && ix < 2 * kHalf && iy >= 0 && iy < 2 * kHalf && iz >= 0 && iz < 2 * kHalf)) {
-      continue;
-    }
-    const uint64_t key = static_cast<uint64_t>(ix) | static_cast<uint64_t>(iy) << 21 |
-                         static_cast<uint64_t>(iz) << 42;
+    const std::optional<uint64_t> cell = preview_cell(p.x(), p.y(), p.z(), config_.cell_m);
+    if (!cell) continue;
+    const uint64_t key = *cell;
     if (key == previous) continue;
     previous = key;
     if (!cells_.insert(key).second) continue;
@@ -67,7 +74,7 @@ std::vector<std::vector<PreviewProfile>> CloudPreview::take() {
         in_group = 0;
       }
       const std::size_t n = std::min(max - in_group, p.p_base_mm.size() - first);
-      PreviewProfile part{p.utime, {}};
+      PreviewProfile part{p.utime, {}, p.T_world_base};
       part.p_base_mm.assign(p.p_base_mm.begin() + static_cast<std::ptrdiff_t>(first),
                             p.p_base_mm.begin() + static_cast<std::ptrdiff_t>(first + n));
       groups.back().push_back(std::move(part));

@@ -30,12 +30,17 @@ struct PreviewConfig {
   std::string channel = "CLOUD_PREVIEW";  // cloud_preview_t; "": no preview
   double cell_m = 0.05;                   // [m] edge of the grid's cells: one point per cell
   int max_points_per_message = 9000;      // 6 bytes each: a message stays under 64 KB
+  // [bytes] what the mapper keeps of the preview to answer a late viewer (preview_resend.hpp):
+  // beyond it the kept points are thinned to a coarser grid, so memory follows the map's extent,
+  // not the run's length. 8 MiB: about 1.3 million points.
+  int64_t resend_max_bytes = 8 << 20;
 
   template <class V>
   void visit(V& v) {
     v("channel", channel);
     v("cell_m", cell_m);
     v("max_points_per_message", max_points_per_message);
+    v("resend_max_bytes", resend_max_bytes);
   }
 };
 
@@ -45,7 +50,12 @@ std::optional<std::string> validate(const PreviewConfig& config);
 struct PreviewProfile {
   int64_t utime = 0;                              // [us] the profile's first beam
   std::vector<std::array<int16_t, 3>> p_base_mm;  // [mm] base frame at utime
+  Pose2 T_world_base;  // the pose it was first placed with (chooses cells, is not sent)
 };
+
+// The cell of a grid of edge cell_m [m] that holds world point (x, y, z) [m], packed into 63 bits
+// (21 per axis: 2^20 cells either side of the origin); nullopt outside that range.
+std::optional<uint64_t> preview_cell(double x, double y, double z, double cell_m);
 
 // Thread-safe: add() on the mapper's thread, take() on the publishing one.
 class CloudPreview {

@@ -87,8 +87,8 @@ int main(int argc, char** argv) {
   const sim::Effects effects = realistic ? cfg.effects : cfg.effects.ideal();
 
   std::unique_ptr<sim::Simulator> simulator;
+  sim::RigConfig rig;  // the rig file, against which the run's true extrinsics are reported
   try {
-    sim::RigConfig rig;
     if (!cfg.rig_file.empty()) load_config(cfg.rig_file, rig);
     sim::WorldSpec world;
     load_config(world_path, world);
@@ -181,6 +181,17 @@ int main(int argc, char** argv) {
   json["true_clocks"]["laser_profile"] = clock_json(truth.profile_clock);
   json["true_clocks"]["imu"] = clock_json(truth.imu_clock);
   json["true_clocks"]["odometry"] = clock_json(truth.odometry_clock);
+  // T_base_sensor as drawn, against the rig file's: yaw [rad] (the horizontal scanner's is the
+  // boresight error the backend estimates), lever arm x, y [m].
+  const auto extrinsic_json = [](const sim::Extrinsic& t, const sim::Extrinsic& nominal) {
+    traverse::Json j;
+    j["yaw_error_rad"] = traverse::json_fixed(t.yaw - nominal.yaw, 6);
+    j["x_error_m"] = traverse::json_fixed(t.x - nominal.x, 4);
+    j["y_error_m"] = traverse::json_fixed(t.y - nominal.y, 4);
+    return j;
+  };
+  json["true_extrinsics"]["laser_horizontal"] =
+      extrinsic_json(truth.laser_horizontal, rig.laser_horizontal);
   std::printf("%s\n", traverse::json_line(json).c_str());
   return rc;
 }

@@ -40,6 +40,7 @@ ViewerNode::ViewerNode(Bus& bus, const ViewerConfig& config, WebServer* server,
     request_resend(
         bus_, "viewer",
         {config_.preview_channel, config_.segments_channel, config_.annotations_channel});
+    ++resend_requests_sent_;
   }
   bus_.subscribe<pose2d_t>(config_.pose_channel, [this](const pose2d_t& m) { on_pose(m); });
   // Every process's status: one subscription for all, decoded here with the bus's checks (a typed
@@ -150,6 +151,7 @@ void ViewerNode::report_counters() {
   counters_(config_.annotations_channel + "/rejected", static_cast<double>(c.annotations_rejected));
   counters_("statuses", statuses_);
   counters_("statuses_stale", statuses_stale_);
+  counters_("resend_requests_sent", resend_requests_sent_);
   counters_(config_.status_prefix + "*/rejected", statuses_rejected_);
   counters_("updates_sent", updates_sent_);
   counters_("update_max_s", update_s_max_);

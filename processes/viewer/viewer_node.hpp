@@ -56,7 +56,7 @@ class ViewerNode {
   bool status_changed_ = false;
   std::string last_guidance_;  // the guidance frame sent last
   double statuses_ = 0, statuses_rejected_ = 0, statuses_stale_ = 0, updates_sent_ = 0,
-         update_s_max_ = 0;
+         update_s_max_ = 0, resend_requests_sent_ = 0;
 };
 
 }  // namespace traverse::viewer

@@ -1,5 +1,6 @@
-// An annotator that starts after the backend (memq://): it asks for the whole graph, the backend
-// answers on KEY_POSES_FULL / POSE_GRAPH_EDGES_FULL, and the late annotator ends with the same
+// An annotator that starts after the backend (memq://): it asks for the whole graph
+// (resend_request_t naming KEY_POSES and POSE_GRAPH_EDGES), the backend answers on
+// KEY_POSES_FULL / POSE_GRAPH_EDGES_FULL, and the late annotator ends with the same
 // bounds, local ones included, as one that was there from the start. Without the request it ends
 // with key poses it never heard of and no local bounds.
 #include <gtest/gtest.h>
@@ -34,15 +35,16 @@ Result run(double join, bool late_asks, bool second = false) {
                                [&](const std::string& k, double v) { r.backend_counters[k] = v; });
   AnnotatorNodeConfig early_config;
   early_config.annotator.republish_fraction = 0.0;  // every recomputed annotation is kept
-  early_config.graph_request_channel = "";          // there from the start: never asks
+  early_config.ask_for_state = false;               // there from the start: never asks
   AnnotatorNodeConfig late_config = early_config;
   late_config.annotations_channel = "ANNOTATIONS_LATE";
-  late_config.graph_request_channel = late_asks ? channels::kGraphRequest : "";
+  late_config.ask_for_state = late_asks;
   AnnotatorNode early(bus, early_config,
                       [&](const std::string& k, double v) { r.early_counters[k] = v; });
   std::unique_ptr<AnnotatorNode> late, second_late;
   bus.subscribe<key_poses_t>(
-      channels::kKeyPosesFull, [&](const key_poses_t&) { ++r.full_key_pose_messages; }, true);
+      channels::full_channel(channels::kKeyPoses),
+      [&](const key_poses_t&) { ++r.full_key_pose_messages; }, true);
   const auto handle_all = [&] {
     while (bus.lcm().handleTimeout(0) > 0) {
     }
@@ -75,8 +77,8 @@ Result run(double join, bool late_asks, bool second = false) {
 TEST(AnnotatorLateJoin, AsksForTheGraphAndEndsWithTheSameBounds) {
   const Result r = run(0.5, true);
   ASSERT_GT(r.key_poses, 20u);
-  EXPECT_EQ(r.backend_counters.at("graph_requests"), r.late_counters.at("graph_requests"));
-  EXPECT_GE(r.backend_counters.at("graph_answers"), 1.0);
+  EXPECT_EQ(r.backend_counters.at("resend_requests"), r.late_counters.at("resend_requests_sent"));
+  EXPECT_GE(r.backend_counters.at("resend_answers"), 1.0);
   EXPECT_GT(r.full_key_pose_messages, 1);  // the answer in parts of 10 key poses
   EXPECT_EQ(r.late_counters.at("edges"), r.early_counters.at("edges"));
   EXPECT_EQ(r.late_counters.at("local_failed"), 0.0);
@@ -102,8 +104,8 @@ TEST(AnnotatorLateJoin, AsksForTheGraphAndEndsWithTheSameBounds) {
 
 TEST(AnnotatorLateJoin, TwoListenersAskingAtOnceGetOneAnswer) {
   const Result r = run(0.5, true, true);
-  EXPECT_EQ(r.backend_counters.at("graph_requests"), 2.0);
-  EXPECT_EQ(r.backend_counters.at("graph_answers"), 1.0);  // graph_resend_min_s apart at most
+  EXPECT_EQ(r.backend_counters.at("resend_requests"), 2.0);
+  EXPECT_EQ(r.backend_counters.at("resend_answers"), 1.0);  // graph_resend_min_s apart at most
   ASSERT_EQ(r.second_late.size(), r.key_poses);
   for (const auto& [id, a] : r.second_late) {
     EXPECT_NEAR(a.local_bound_m, r.late.at(id).local_bound_m, 1e-12) << id;
@@ -112,7 +114,7 @@ TEST(AnnotatorLateJoin, TwoListenersAskingAtOnceGetOneAnswer) {
 
 TEST(AnnotatorLateJoin, WithoutAskingItMissesKeyPosesAndLocalBounds) {
   const Result r = run(0.5, false);
-  EXPECT_EQ(r.backend_counters.at("graph_answers"), 0.0);
+  EXPECT_EQ(r.backend_counters.at("resend_answers"), 0.0);
   EXPECT_GT(r.late_counters.at("edges_missed"), 0.0);
   int without_local = 0;
   for (const auto& [id, l] : r.late) without_local += l.local_bound_m < 0.0;

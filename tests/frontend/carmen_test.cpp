@@ -25,6 +25,7 @@ struct Metrics {
   int scans = 0;
   int predicted = 0;
   int searched = 0;
+  double widened = 0, moved_by_widening = 0;  // sparse/widen.hpp's counters
   evaluator::Evaluation ev;  // as traverse-evaluator computes it (rpe, max_jump, step NEES)
 };
 
@@ -65,6 +66,10 @@ Metrics run_log(const std::string& path) {
     take(frontend->process(scan));
   }
   if (const auto r = frontend->finish()) take(*r);
+  frontend->report([&m](const std::string& name, double value) {
+    if (name == "scans_widened") m.widened = value;
+    if (name == "scans_moved_by_widening") m.moved_by_widening = value;
+  });
   m.scans = static_cast<int>(est.size());
   m.ev = evaluator::evaluate(est, ref, evaluator::EvaluatorConfig{});
   return m;
@@ -97,9 +102,9 @@ TEST_P(CarmenLog, TracksReference) {
   const double outside_99 = *ev.step_consistency.outside_99_fraction;
   std::printf(
       "%s: %d scans, %d predicted, %d searched, rpe_1m %.4f m, rpe_10m %.4f m, max_jump %.4f m, "
-      "step NEES median %.2f, outside the 99 %% ellipse %.1f %%\n",
+      "step NEES median %.2f, outside the 99 %% ellipse %.1f %%; widened %.0f, moved by it %.0f\n",
       c.name, m.scans, m.predicted, m.searched, rpe_1m, rpe_10m, ev.max_jump.step_error_m,
-      nees_median, 100.0 * outside_99);
+      nees_median, 100.0 * outside_99, m.widened, m.moved_by_widening);
   EXPECT_GT(m.scans, c.min_scans);
   EXPECT_EQ(m.predicted, 0);
   EXPECT_LT(rpe_1m, c.max_rpe_1m_m);

@@ -14,9 +14,9 @@ namespace {
 // Programs that are not processes of the graph (no --config/--lcm-url contract). Everything else
 // in bin/traverse-* is a process.
 const std::set<std::string> kTools = {
-    "validate",          "launch",       "frontend-bench", "pgo", "pgo-ceres", "cloud-eval",
-    "densifier-compare", "mapper-bench", "sim-realism", "annotator-eval",
-    "export"};
+    "validate",      "launch",      "frontend-bench",    "pgo",
+    "pgo-ceres",     "cloud-eval",  "densifier-compare", "mapper-bench",
+    "preview-bench", "sim-realism", "annotator-eval",    "export"};
 
 // Processes that need inputs besides a config to start at all get them here; the config must
 // still be checked, and named when wrong.

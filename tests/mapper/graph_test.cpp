@@ -6,6 +6,7 @@
 #include <octomap/ColorOcTree.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -42,6 +43,7 @@ class GraphTest : public ::testing::TestWithParam<bool> {
     out_dir_ = std::filesystem::temp_directory_path() /
                ("traverse_graph_test_" + std::to_string(::getpid()) + (GetParam() ? "_w" : "_i"));
     mc.output_dir = out_dir_.string();
+    mc.preview.resend_max_bytes = resend_max_bytes_;
     Eigen::Isometry3d T_base_laser = Eigen::Isometry3d::Identity();
     T_base_laser.linear() =
         Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -104,6 +106,7 @@ class GraphTest : public ::testing::TestWithParam<bool> {
   void TearDown() override { std::filesystem::remove_all(out_dir_); }
 
   Bus bus_{"memq://"};
+  int64_t resend_max_bytes_ = mapper::PreviewConfig{}.resend_max_bytes;
   std::filesystem::path out_dir_;
   std::unique_ptr<densifier::DensifierNode> densifier_;
   std::unique_ptr<mapper::MapperNode> mapper_;
@@ -321,10 +324,23 @@ TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 7.0);
 }
 
+// The preview's points per profile time, as a viewer puts the parts of a profile together.
+std::map<int64_t, std::vector<std::array<int16_t, 3>>> preview_points(
+    const std::vector<cloud_preview_t>& messages) {
+  std::map<int64_t, std::vector<std::array<int16_t, 3>>> out;
+  for (const cloud_preview_t& m : messages) {
+    for (const preview_profile_t& p : m.profiles) {
+      for (int i = 0; i < p.n_points; ++i)
+        out[p.utime].push_back({p.x_mm[i], p.y_mm[i], p.z_mm[i]});
+    }
+  }
+  return out;
+}
+
 // A listener that starts late asks once for what came before (resend.hpp): the densifier answers
 // with the newest revision of every segment on DENSE_SEGMENTS_FULL, the mapper with every preview
-// message it sent on CLOUD_PREVIEW_FULL, and neither answer reaches the incremental channels. The
-// mapper, in turn, takes the annotator's answer on ANNOTATIONS_FULL like ANNOTATIONS.
+// point it sent (under its cap) on CLOUD_PREVIEW_FULL, and neither answer reaches the incremental
+// channels. The mapper, in turn, takes the annotator's answer on ANNOTATIONS_FULL like ANNOTATIONS.
 TEST_P(GraphTest, ALateListenerGetsEverySegmentAndPreviewProfileAgain) {
   std::vector<cloud_preview_t> preview, preview_again;
   std::vector<dense_segment_t> segments_again;
@@ -357,12 +373,7 @@ TEST_P(GraphTest, ALateListenerGetsEverySegmentAndPreviewProfileAgain) {
     EXPECT_EQ(segments_again[i].revision, i >= 4 ? 1 : 0);
   }
   EXPECT_NEAR(segments_again[5].y.front(), 0.05, 1e-12);
-  ASSERT_EQ(preview_again.size(), preview.size());
-  for (std::size_t i = 0; i < preview.size(); ++i) {
-    ASSERT_EQ(preview_again[i].n_profiles, preview[i].n_profiles);
-    EXPECT_EQ(preview_again[i].profiles[0].utime, preview[i].profiles[0].utime);
-    EXPECT_EQ(preview_again[i].profiles[0].x_mm, preview[i].profiles[0].x_mm);
-  }
+  EXPECT_EQ(preview_points(preview_again), preview_points(preview));
 
   annotations_t a{};
   a.utime = kT0;
@@ -378,7 +389,64 @@ TEST_P(GraphTest, ALateListenerGetsEverySegmentAndPreviewProfileAgain) {
   mapper_->report_counters();
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 2.0);
   EXPECT_EQ(mapper_counters_.at("resend_answers"), 1.0);
+  EXPECT_EQ(mapper_counters_.at("resend_requests"), 1.0);
+  EXPECT_EQ(mapper_counters_.at("resend_requests_sent"), 1.0);  // the annotations, at start
 }
+
+// The mapper keeps what it resends under preview.resend_max_bytes: after a run longer than that,
+// the late listener gets fewer points than were sent live, never more bytes than the cap, and
+// still the whole route, its start included (the earliest point of each coarser cell is kept).
+class SmallResendTest : public GraphTest {
+ protected:
+  void SetUp() override {
+    resend_max_bytes_ = 4 << 10;
+    GraphTest::SetUp();
+  }
+};
+
+TEST_P(SmallResendTest, ALateListenerGetsTheWholeRouteUnderTheCap) {
+  std::vector<cloud_preview_t> preview, preview_again;
+  bus_.subscribe<cloud_preview_t>(channels::kCloudPreview,
+                                  [&](const cloud_preview_t& m) { preview.push_back(m); });
+  bus_.subscribe<cloud_preview_t>(channels::full_channel(channels::kCloudPreview),
+                                  [&](const cloud_preview_t& m) { preview_again.push_back(m); });
+  drive(300, true);  // 6 s, 3 m
+  mapper_->flush();
+  mapper_->publish_preview();
+  handle_all();
+  request_resend(bus_, "test", {channels::kCloudPreview});
+  handle_all();
+  mapper_->publish_preview();
+  handle_all();
+  const auto live = preview_points(preview), again = preview_points(preview_again);
+  int64_t live_points = 0, again_points = 0;
+  for (const auto& [t, pts] : live) live_points += static_cast<int64_t>(pts.size());
+  for (const auto& [t, pts] : again) {
+    again_points += static_cast<int64_t>(pts.size());
+    ASSERT_TRUE(live.count(t)) << t;  // points of profiles sent live, nothing made up
+    for (const auto& q : pts) {
+      EXPECT_NE(std::find(live.at(t).begin(), live.at(t).end(), q), live.at(t).end());
+    }
+  }
+  mapper_->report_counters();
+  RecordProperty("live_points", std::to_string(live_points));
+  RecordProperty("resent_points", std::to_string(again_points));
+  ASSERT_GT(live_points * 6, 2 * resend_max_bytes_);  // a run longer than the cap
+  EXPECT_GT(again_points, 0);
+  EXPECT_LT(again_points, live_points);
+  EXPECT_LE(mapper_counters_.at("preview_resend_bytes"), static_cast<double>(resend_max_bytes_));
+  EXPECT_LE(again_points * 6, resend_max_bytes_);
+  EXPECT_GT(mapper_counters_.at("preview_resend_compactions"), 0.0);
+  EXPECT_EQ(mapper_counters_.at("preview_resend_points_compacted"),
+            static_cast<double>(live_points - again_points));
+  // The start and the end of the route: the first profile (its points are the earliest of their
+  // cells), and one of the last second.
+  EXPECT_EQ(again.begin()->first, live.begin()->first);
+  EXPECT_GT(again.rbegin()->first, live.rbegin()->first - 1'000'000);
+}
+
+INSTANTIATE_TEST_SUITE_P(Mapper, SmallResendTest, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "worker" : "inline"; });
 
 INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "worker" : "inline"; });

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "mapper.hpp"
+#include "preview_resend.hpp"
 
 namespace traverse::mapper {
 namespace {
@@ -94,6 +95,109 @@ TEST(CloudPreview, ComesFromTheMappersPlacementOncePerProfile) {
   ASSERT_TRUE(mapper.set_segment(segment(0.3)));
   mapper.apply_moves();
   EXPECT_EQ(calls, 1);
+}
+
+// A corridor 3 m wide and 2.5 m high, driven straight along x for `length_m`: each profile is the
+// ring of walls, floor and ceiling 0.4 m ahead of the cart, every 2 cm, one profile per 5 cm of
+// travel (so each brings one new slice of cells, as a first pass through a building does), from
+// `from_m` to `to_m` at 1.5 m/s. The preview's groups go into `resend` as the mapper node does;
+// returns the points sent live.
+int64_t drive_corridor(double from_m, double to_m, PreviewResend& resend,
+                       int64_t max_bytes_seen[1]) {
+  CloudPreview preview({.channel = "CLOUD_PREVIEW", .cell_m = 0.05});
+  int64_t sent = 0;
+  for (int i = static_cast<int>(std::lround(from_m / 0.05)); 0.05 * i <= to_m; ++i) {
+    const Pose2 T(0.05 * i, 0.0, 0.0);
+    const float x = static_cast<float>(T.x() + 0.4);
+    std::vector<Eigen::Vector3f> ring;
+    for (float y = -1.5f; y <= 1.5f; y += 0.02f) {
+      ring.emplace_back(x, y, 0.0f);
+      ring.emplace_back(x, y, 2.5f);
+    }
+    for (float z = 0.0f; z <= 2.5f; z += 0.02f) {
+      ring.emplace_back(x, -1.5f, z);
+      ring.emplace_back(x, 1.5f, z);
+    }
+    preview.add(kT0 + i * 33'000, T, ring);
+    for (const auto& group : preview.take()) {
+      for (const PreviewProfile& p : group) {
+        sent += static_cast<int64_t>(p.p_base_mm.size());
+        resend.add(p);
+        max_bytes_seen[0] = std::max(max_bytes_seen[0], resend.bytes());
+      }
+    }
+  }
+  return sent;
+}
+
+// What a late viewer is sent after a long run: bounded by the cap however long the run, and a
+// picture of the whole route, the start included (the earliest point of each coarse cell is kept).
+TEST(PreviewResend, StaysUnderItsCapAndCoversTheWholeRoute) {
+  constexpr int64_t kCap = 256 << 10;
+  PreviewResend resend(0.05, kCap);
+  int64_t max_bytes[1] = {0};
+  const int64_t sent = drive_corridor(0.0, 200.0, resend, max_bytes);
+  // Everything sent live would have been kept before: 6 bytes a point.
+  ASSERT_GT(sent * 6, 10 * kCap);
+  EXPECT_LE(max_bytes[0], kCap);
+  EXPECT_LE(resend.bytes(), kCap);
+  EXPECT_GT(resend.counters().compactions, 0);
+  EXPECT_EQ(resend.counters().points_compacted, sent - resend.points());
+  EXPECT_GT(resend.cell_m(), 0.05);
+  RecordProperty("points_sent_live", std::to_string(sent));
+  RecordProperty("points_kept", std::to_string(resend.points()));
+  RecordProperty("cell_m", std::to_string(resend.cell_m()));
+
+  resend.restart();
+  std::vector<int> per_metre(201, 0);
+  int64_t answered = 0, last_utime = 0;
+  bool first_profile = false;
+  while (resend.resending()) {
+    const std::vector<PreviewProfile> part = resend.next(9000);
+    std::size_t n = 0;
+    for (const PreviewProfile& p : part) {
+      EXPECT_GE(p.utime, last_utime);  // in time order, a long profile continued
+      last_utime = p.utime;
+      first_profile |= p.utime == kT0;
+      n += p.p_base_mm.size();
+      for (const auto& q : p.p_base_mm) {
+        const double x = p.T_world_base.x() + q[0] * 1e-3;
+        ++per_metre[std::clamp(static_cast<int>(x), 0, 200)];
+      }
+    }
+    ASSERT_GT(n, 0u);
+    EXPECT_LE(n, 9000u);
+    answered += static_cast<int64_t>(n);
+  }
+  EXPECT_EQ(answered, resend.points());
+  EXPECT_TRUE(first_profile);  // the very start of the route
+  for (int m = 0; m < 200; ++m) EXPECT_GT(per_metre[m], 0) << "no point between " << m << " m";
+}
+
+// The answer is paced out over seconds while the route goes on: a thinning pass meanwhile leaves
+// it going on in time order, under the cap, to the end.
+TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
+  PreviewResend resend(0.05, 64 << 10);
+  int64_t max_bytes[1] = {0};
+  drive_corridor(0.0, 20.0, resend, max_bytes);
+  const int64_t compactions = resend.counters().compactions;
+  resend.restart();
+  std::vector<PreviewProfile> got = resend.next(50);
+  ASSERT_FALSE(got.empty());
+  // More route arrives while the answer is paced out: the kept points are thinned again.
+  drive_corridor(20.05, 80.0, resend, max_bytes);
+  EXPECT_GT(resend.counters().compactions, compactions);
+  EXPECT_LE(max_bytes[0], 64 << 10);
+  int64_t last_utime = got.back().utime;
+  std::size_t answered = 0;
+  while (resend.resending()) {
+    for (const PreviewProfile& p : resend.next(50)) {
+      EXPECT_GE(p.utime, last_utime);
+      last_utime = p.utime;
+      answered += p.p_base_mm.size();
+    }
+  }
+  EXPECT_GT(answered, 0u);
 }
 
 }  // namespace

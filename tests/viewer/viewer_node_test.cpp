@@ -164,6 +164,7 @@ TEST_F(ViewerNodeTest, AsksForWhatCameBeforeAndTakesTheAnswersOnce) {
   EXPECT_EQ(node.scene().profiles().size(), 2u);
   EXPECT_EQ(node.scene().points(), 4);  // the repeated profile's points once
   EXPECT_EQ(counters_.at("profiles_repeated"), 1);
+  EXPECT_EQ(counters_.at("resend_requests_sent"), 1);
   EXPECT_TRUE(node.scene().profiles()[0].placed);
   EXPECT_EQ(node.scene().annotations().size(), 3u);
   EXPECT_EQ(node.scene().polylines().size(), 1u);

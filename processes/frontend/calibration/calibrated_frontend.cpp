@@ -25,14 +25,11 @@ std::optional<FrontendResult> CalibratedFrontend::finish() {
 }
 
 Pose2 CalibratedFrontend::to_base(const Pose2& T_map_bhat, double delta) const {
-  const Eigen::Vector2d p0 = T_initial_.translation();
-  const Eigen::Vector2d p =
-      p0 + Pose2(0.0, 0.0, delta).rotation() * (T_map_bhat.translation() - p0);
-  return Pose2(p.x(), p.y(), T_map_bhat.theta());
+  return calibration::turned_about(T_map_bhat, T_initial_.translation(), delta);
 }
 
 FrontendResult CalibratedFrontend::calibrated(FrontendResult r) {
-  if (r.status == ScanStatus::kMatched) yaw_.add_pose(r.utime, r.T_map_base);
+  if (r.status == ScanStatus::kMatched) yaw_.add_pose(r.T_map_base);
   const auto delta = yaw_.yaw_rad();
   if (!delta || !r.has_pose()) return r;
   r.T_map_base = to_base(r.T_map_base, *delta);

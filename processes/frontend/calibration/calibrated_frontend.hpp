@@ -1,5 +1,6 @@
 // A frontend of any kind wrapped so that its poses come out in the frame of the base the rig
-// file meant, with the scanner's yaw on the cart estimated while it runs (extrinsic_yaw.hpp).
+// file meant, with the scanner's yaw on the cart estimated while it runs
+// (common/extrinsic_yaw.hpp).
 //
 // The inner frontend matches scans in the frame bhat the rig file's T_base_laser gives the scans
 // (the true base turned by the scanner's yaw error delta, T_base_bhat = Rot(delta)); its map and
@@ -36,7 +37,7 @@ class CalibratedFrontend final : public FrontendWrapper<Frontend> {
   Pose2 to_base(const Pose2& T_map_bhat, double delta) const;
 
   Pose2 T_initial_;
-  ExtrinsicYawEstimator yaw_;
+  calibration::ExtrinsicYawEstimator yaw_;
 };
 
 }  // namespace traverse::frontend

@@ -49,20 +49,24 @@ std::optional<FrontendResult> SparseLag::finish() {
   return r;
 }
 
-double SparseLag::score(const Held& held, const Pose2& T, const Pose2& T_next,
-                        const std::optional<Pose2>& odometry_next) const {
+double SparseLag::score(const Held& held, const Pose2& T, const Measurement& next,
+                        const Pose2& T_next) const {
   const double evidence = inner_->evidence(held.measurement, T);
   double cost = step_prior_cost(step_prior(config_, held.T_before), T) +
                 step_prior_cost(step_prior(config_, T), T_next);
   if (recent_steps_m_.size() >= kRecentSteps / 2) {
-    // A step odometry measured long is not long for the log: its limit grows with it.
+    // A step odometry measured long, or a wider search found long, is not long for the log:
+    // its limit grows with it.
     const double usual = recent_steps_m_.percentile(90);
-    const auto limit = [&](const std::optional<Pose2>& odometry) {
-      return kLongStepFactor * (odometry ? std::max(usual, odometry->translation().norm()) : usual);
+    const auto limit = [&](const Measurement& m) {
+      double longest = usual;
+      if (m.odometry_step) longest = std::max(longest, m.odometry_step->translation().norm());
+      if (m.long_step_m) longest = std::max(longest, *m.long_step_m);
+      return kLongStepFactor * longest;
     };
     const std::pair<double, double> steps[] = {
-        {between(held.T_before, T).translation().norm(), limit(held.measurement.odometry_step)},
-        {between(T, T_next).translation().norm(), limit(odometry_next)}};
+        {between(held.T_before, T).translation().norm(), limit(held.measurement)},
+        {between(T, T_next).translation().norm(), limit(next)}};
     for (const auto& [length, limit_m] : steps) {
       const double e = std::max(0.0, length - limit_m) / kLongStepScaleM;
       cost += config_.sparse_lag_long_weight * e * e;
@@ -90,8 +94,8 @@ FrontendResult SparseLag::settle(Held held, Measurement* next) {
       undone = true;
       const Measurement alt = inner_->rematch(
           k, {mid, config_.sparse_lag_window_m, config_.sparse_lag_window_rad, held.T_before});
-      const double own = score(held, k.result.T_map_base, T_next, next->odometry_step);
-      const double other = score(held, alt.result.T_map_base, T_next, next->odometry_step);
+      const double own = score(held, k.result.T_map_base, *next, T_next);
+      const double other = score(held, alt.result.T_map_base, *next, T_next);
       if (!poses_agree(alt.result.T_map_base, k.result.T_map_base)) {
         const Pose2 T_own = k.result.T_map_base;
         revised = other > own + config_.sparse_lag_margin;

@@ -13,7 +13,8 @@
 //     the map without scan k: evidence per point, minus the step prior of the steps into and out
 //     of the pose (step_prior.hpp), minus sparse_lag_long_weight per point at 0.3 m beyond 1.25
 //     times the log's usual step (90th percentile of the last 30 settled steps; a step that
-//     wheel odometry measured longer than that, 1.25 times odometry's). The other pose
+//     wheel odometry measured, or a widened search found, longer than that: 1.25 times its
+//     length; sparse/widen.hpp). The other pose
 //     is taken if it scores sparse_lag_margin per point more; the pose not taken joins the
 //     covariance as a second place the pose may be (the score spread of the two, weighted as the
 //     wide search weighs its surface). Scan k is integrated where it settled, and if it moved,
@@ -50,10 +51,8 @@ class SparseLag final : public FrontendWrapper<TwoPhaseFrontend> {
   // Settles the held scan given the next scan's measurement (none at the end of the stream),
   // matching `next` again if the held scan moved; returns the held scan's result.
   FrontendResult settle(Held held, Measurement* next);
-  // The lag's score of the held scan at T (see the header) with the next scan at T_next, whose
-  // odometry step is `odometry_next` if it had one.
-  double score(const Held& held, const Pose2& T, const Pose2& T_next,
-               const std::optional<Pose2>& odometry_next) const;
+  // The lag's score of the held scan at T (see the header) with the next scan, `next`, at T_next.
+  double score(const Held& held, const Pose2& T, const Measurement& next, const Pose2& T_next) const;
 
   MatcherConfig config_;
   bool lagging_ = false;

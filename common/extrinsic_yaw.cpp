@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace traverse::frontend {
+#include "config.hpp"
+
+namespace traverse::calibration {
 namespace {
 
 // A chord turning more than this is left out: a turn on the spot, a corner, where its direction
@@ -20,14 +22,37 @@ constexpr double kLeverArmPriorSigmaM = 0.5;
 
 }  // namespace
 
+std::optional<std::string> validate(const ExtrinsicYawConfig& c) {
+  ConfigCheck check;
+  check.in_range("chord_m", c.chord_m, 0.05, 100.0);
+  check.in_range("min_travel_m", c.min_travel_m, 0.0, 1e6);
+  check.in_range("max_yaw_rad", c.max_yaw_rad, 0.0, 0.5);
+  return check.problem();
+}
+
+Pose2 turned_about(const Pose2& T_map_bhat, const Eigen::Vector2d& origin, double delta) {
+  const Eigen::Vector2d p =
+      origin + Pose2(0.0, 0.0, delta).rotation() * (T_map_bhat.translation() - origin);
+  return Pose2(p.x(), p.y(), T_map_bhat.theta());
+}
+
+void ExtrinsicYawEstimator::reset() {
+  chord_.clear();
+  A_.setZero();
+  b_.setZero();
+  c_ = 0.0;
+  travel_m_ = 0.0;
+  chords_ = rejected_ = 0;
+}
+
 void ExtrinsicYawEstimator::restart(const Pose2& T) {
   chord_.clear();
   chord_.push_back(T);
 }
 
-ExtrinsicYawEstimator::ExtrinsicYawEstimator(const CalibrationConfig& config) : config_(config) {}
+ExtrinsicYawEstimator::ExtrinsicYawEstimator(const ExtrinsicYawConfig& config) : config_(config) {}
 
-void ExtrinsicYawEstimator::add_pose(int64_t /*utime*/, const Pose2& T) {
+void ExtrinsicYawEstimator::add_pose(const Pose2& T) {
   if (chord_.empty()) {
     chord_.push_back(T);
     return;
@@ -70,16 +95,32 @@ void ExtrinsicYawEstimator::add_pose(int64_t /*utime*/, const Pose2& T) {
   const double w = d * d / (2.0 * kPositionSigmaM * kPositionSigmaM);
   A_ += w * h * h.transpose();
   b_ += w * phi * h;
+  c_ += w * phi * phi;
   travel_m_ += d;
   ++chords_;
 }
 
-Eigen::Vector2d ExtrinsicYawEstimator::solution() const {
+Eigen::Matrix2d ExtrinsicYawEstimator::normal_matrix() const {
   // The priors (zero mean) keep the fit defined before any chord, and a before any turn.
   Eigen::Matrix2d A = A_;
   A(0, 0) += 1.0 / (kYawPriorSigmaRad * kYawPriorSigmaRad);
   A(1, 1) += 1.0 / (kLeverArmPriorSigmaM * kLeverArmPriorSigmaM);
-  return A.inverse() * b_;
+  return A;
+}
+
+Eigen::Vector2d ExtrinsicYawEstimator::solution() const { return normal_matrix().inverse() * b_; }
+
+double ExtrinsicYawEstimator::yaw_sigma_rad() const {
+  const Eigen::Matrix2d covariance = normal_matrix().inverse();
+  // The chords' weighted squared residuals about the fit (c - 2 x'b + x'A x) over their degrees
+  // of freedom: the factor by which the assumed position noise was too small, if it was.
+  double factor = 1.0;
+  if (chords_ > 2) {
+    const Eigen::Vector2d x = solution();
+    const double chi2 = c_ - 2.0 * x.dot(b_) + x.dot(A_ * x);
+    factor = std::max(1.0, chi2 / static_cast<double>(chords_ - 2));
+  }
+  return std::sqrt(factor * covariance(0, 0));
 }
 
 std::optional<double> ExtrinsicYawEstimator::yaw_rad() const {
@@ -89,4 +130,4 @@ std::optional<double> ExtrinsicYawEstimator::yaw_rad() const {
   return delta;
 }
 
-}  // namespace traverse::frontend
+}  // namespace traverse::calibration
