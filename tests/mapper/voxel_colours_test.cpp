@@ -15,7 +15,7 @@
 namespace traverse::mapper {
 namespace {
 
-constexpr int64_t kT0 = 1'600'000'000'000'000;
+constexpr int64_t kVoxelT0 = 1'600'000'000'000'000;
 constexpr std::array<uint8_t, 3> kGreen{0, 200, 0}, kOrange{255, 128, 0}, kRed{230, 0, 0};
 
 // The cart stands at A (1, 2) until 300 ms, then at B, 20 m east, from 400 ms on.
@@ -23,9 +23,9 @@ TrajectorySegment standing_then_moved() {
   TrajectorySegment s;
   s.key_id_first = 0;
   for (int i = 0; i <= 80; ++i) {
-    const int64_t t = kT0 + i * 10'000;
+    const int64_t t = kVoxelT0 + i * 10'000;
     s.utimes.push_back(t);
-    s.T_world_base.push_back(t <= kT0 + 300'000 ? Pose2(1.0, 2.0, 0.3) : Pose2(21.0, 2.0, 0.3));
+    s.T_world_base.push_back(t <= kVoxelT0 + 300'000 ? Pose2(1.0, 2.0, 0.3) : Pose2(21.0, 2.0, 0.3));
   }
   return s;
 }
@@ -45,9 +45,9 @@ class VoxelColours : public ::testing::Test {
  protected:
   VoxelColours() : mapper_(config(), extrinsic()) {
     mapper_.set_segment(standing_then_moved());
-    mapper_.add_profile(arc(kT0));            // at A, nearest key pose 0
-    mapper_.add_profile(arc(kT0 + 200'000));  // at A again, nearest key pose 1
-    mapper_.add_profile(arc(kT0 + 600'000));  // at B, nearest key pose 2
+    mapper_.add_profile(arc(kVoxelT0));            // at A, nearest key pose 0
+    mapper_.add_profile(arc(kVoxelT0 + 200'000));  // at A again, nearest key pose 1
+    mapper_.add_profile(arc(kVoxelT0 + 600'000));  // at B, nearest key pose 2
   }
   static MapperConfig config() {
     MapperConfig c;
@@ -94,9 +94,9 @@ TEST_F(VoxelColours, EachVoxelTakesTheWorstLevelOfItsPoints) {
   // The same voxels at A from key poses 0 and 1; the worse of the two wins, in either order.
   for (const bool worse_first : {false, true}) {
     PointColours colours;
-    colours.set(0, kT0, worse_first ? 3 : 1, worse_first ? kOrange : kGreen);
-    colours.set(1, kT0 + 200'000, worse_first ? 1 : 3, worse_first ? kGreen : kOrange);
-    colours.set(2, kT0 + 600'000, 4, kRed);
+    colours.set(0, kVoxelT0, worse_first ? 3 : 1, worse_first ? kOrange : kGreen);
+    colours.set(1, kVoxelT0 + 200'000, worse_first ? 1 : 3, worse_first ? kGreen : kOrange);
+    colours.set(2, kVoxelT0 + 600'000, 4, kRed);
     VoxelColourCounts counts;
     const auto read = round_trip(colours, counts);
     const auto* tree = dynamic_cast<const octomap::ColorOcTree*>(read.get());

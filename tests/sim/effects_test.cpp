@@ -14,7 +14,7 @@
 namespace traverse::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 // A wall across the x axis at x = 10, materials for the tests, and whatever a test adds.
 WorldSpec scene(double wall_reflectivity = 0.5) {
@@ -148,8 +148,8 @@ TEST(Calibration, AYawErrorTurnsTheWallInTheScan) {
   const Extrinsic nominal{0, 0, 0.5, 0, 0, 0};
   const Extrinsic truth = perturb_extrinsic(nominal, c, rng);
   const double err = truth.yaw - nominal.yaw;
-  EXPECT_GE(std::abs(err), 0.1 * kDeg);
-  EXPECT_LE(std::abs(err), 0.3 * kDeg);
+  EXPECT_GE(std::abs(err), 0.1 * kRadPerDeg);
+  EXPECT_LE(std::abs(err), 0.3 * kRadPerDeg);
   // The nearest point of the wall (its normal) appears at -err in the scan, not at 0.
   auto normal_angle = [&](const Extrinsic& e) {
     ScannerSim sc = s.scanner(m, {}, e);
@@ -273,13 +273,13 @@ TEST(IncidenceMaterials, GlassReturnsHeadOnAndMirrorsAtGrazingAngles) {
   double p_return, p_mirror;
   incidence_probabilities(glass, 0.0, p_return, p_mirror);
   EXPECT_NEAR(p_return, 1.0, 1e-12);  // the pane reflects straight back
-  incidence_probabilities(glass, 30 * kDeg, p_return, p_mirror);
+  incidence_probabilities(glass, 30 * kRadPerDeg, p_return, p_mirror);
   EXPECT_LT(p_return, 0.08);
   EXPECT_LT(p_mirror, 0.1);  // most beams pass
-  incidence_probabilities(glass, 85 * kDeg, p_return, p_mirror);
+  incidence_probabilities(glass, 85 * kRadPerDeg, p_return, p_mirror);
   EXPECT_GT(p_mirror, 0.5);  // Fresnel: grazing beams mirror
   const Material steel{"metal", 0.9, 0.7, 0.3};
-  incidence_probabilities(steel, 60 * kDeg, p_return, p_mirror);
+  incidence_probabilities(steel, 60 * kRadPerDeg, p_return, p_mirror);
   EXPECT_NEAR(p_return + p_mirror, 1.0, 1e-12);  // steel never lets a beam through
   EXPECT_GT(p_mirror, 0.5);
 }
@@ -297,7 +297,7 @@ TEST(AngleJitter, ScattersPointsOffAWallAsTheAngleDoes) {
   int n = 0;
   for (int i = 0; i < m.points; ++i) {
     const double ang = a.angle_first + i * a.angle_step;
-    if (std::abs(ang) < 20 * kDeg || std::abs(ang) > 40 * kDeg || b.ranges[i] <= 0) continue;
+    if (std::abs(ang) < 20 * kRadPerDeg || std::abs(ang) > 40 * kRadPerDeg || b.ranges[i] <= 0) continue;
     const double off = b.ranges[i] * std::cos(ang) - a.ranges[i] * std::cos(ang);
     sum2 += off * off;
     expected2 += std::pow(10.0 * std::tan(ang) * 1e-3, 2);
