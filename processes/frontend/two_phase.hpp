@@ -31,6 +31,11 @@ struct Measurement {
   std::optional<double> long_step_m;
 };
 
+// A result the wide search matched as a sparse scan: what the wrappers of sparse/ work on.
+inline bool matched_sparse(const FrontendResult& r) {
+  return r.status == ScanStatus::kMatched && r.sparse;
+}
+
 // Where to match a measurement again: around T_centre, within +-linear_window_m in x and y and
 // +-angular_window_rad, the step from T_from (the pose before) weighed by the step prior.
 struct SearchArea {

@@ -15,10 +15,6 @@ namespace {
 constexpr double kLongStepFactor = 1.25;
 constexpr double kLongStepScaleM = 0.3;
 
-bool matched_sparse(const FrontendResult& r) {
-  return r.status == ScanStatus::kMatched && r.sparse;
-}
-
 }  // namespace
 
 SparseLag::SparseLag(std::unique_ptr<TwoPhaseFrontend> frontend, const MatcherConfig& config)

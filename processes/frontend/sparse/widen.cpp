@@ -1,13 +1,6 @@
 #include "widen.hpp"
 
 namespace traverse::frontend {
-namespace {
-
-bool matched_sparse(const FrontendResult& r) {
-  return r.status == ScanStatus::kMatched && r.sparse;
-}
-
-}  // namespace
 
 SparseWiden::SparseWiden(std::unique_ptr<TwoPhaseFrontend> inner, const MatcherConfig& config)
     : inner_(std::move(inner)), config_(config) {}
