@@ -15,18 +15,11 @@
 #include <tuple>
 
 #include "channels.hpp"
-#include "densifier_node.hpp"
-#include "mapper_node.hpp"
+#include "graph_fixture.hpp"
 #include "ply.hpp"
-#include "resend.hpp"
-#include "test_profile.hpp"
 
 namespace traverse {
 namespace {
-
-constexpr int64_t kT0 = 1'700'000'000'000'000;
-constexpr int64_t kPoseDt = 20'000;  // [us] 50 Hz frontend
-constexpr int kKeyEvery = 15;
 
 struct KeyLess {
   bool operator()(const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) const {
@@ -34,87 +27,6 @@ struct KeyLess {
   }
 };
 
-// Parameter: the mapper on its own worker thread (live) or inline (replay).
-class GraphTest : public ::testing::TestWithParam<bool> {
- protected:
-  void SetUp() override {
-    mapper::MapperConfig mc;
-    mc.footprint = {-0.1, 0.1, -0.1, 0.1, 0.02, 0.5};
-    out_dir_ = std::filesystem::temp_directory_path() /
-               ("traverse_graph_test_" + std::to_string(::getpid()) + (GetParam() ? "_w" : "_i"));
-    mc.output_dir = out_dir_.string();
-    mc.preview.resend_max_bytes = resend_max_bytes_;
-    Eigen::Isometry3d T_base_laser = Eigen::Isometry3d::Identity();
-    T_base_laser.linear() =
-        Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    T_base_laser.translation() = Eigen::Vector3d(0.4, 0, 1.0);
-    densifier_ = std::make_unique<densifier::DensifierNode>(bus_, densifier::DensifierConfig{});
-    mapper_ = std::make_unique<mapper::MapperNode>(
-        bus_, mc, T_base_laser,
-        [this](const std::string& name, double v) { mapper_counters_[name] = v; }, GetParam());
-    bus_.subscribe<dense_segments_t>(channels::kDenseSegments, [this](const dense_segments_t& m) {
-      messages_.push_back(m);
-      segments_.insert(segments_.end(), m.segments.begin(), m.segments.end());
-    });
-    // One bus for producer and listener: its order check would see the producer's own last
-    // time, so the test checks the order itself.
-    bus_.subscribe<pose2d_t>(
-        channels::kPoseDense, [this](const pose2d_t& m) { dense_.push_back(m); }, true);
-  }
-  void handle_all() {
-    while (bus_.lcm().handleTimeout(0) > 0) {
-    }
-  }
-  void send_keys(const std::vector<int>& indices, double y, int optimisation = 1) {
-    key_poses_t msg{};
-    msg.optimisation = optimisation;
-    msg.utime = kT0 + indices.back() * kKeyEvery * kPoseDt;
-    msg.parts = 1;
-    for (int k : indices) {
-      key_pose_t p{};
-      p.utime = kT0 + k * kKeyEvery * kPoseDt;
-      p.id = k;
-      p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
-      p.y = y;
-      msg.poses.push_back(p);
-    }
-    msg.n_poses = static_cast<int32_t>(msg.poses.size());
-    bus_.publish(channels::kKeyPoses, msg);
-  }
-  void send_profile(int64_t t0) {
-    planar_scan_t s = test_profile(t0, std::vector<float>(360, 2.0f));
-    bus_.publish(channels::kScanProfile, s);
-  }
-
-  // Frontend poses 0..n_poses 1 cm north of the truth, key poses (the truth) every kKeyEvery.
-  void drive(int n_poses, bool profiles) {
-    for (int i = 0; i <= n_poses; ++i) {
-      pose2d_t p{};
-      p.utime = kT0 + i * kPoseDt;
-      p.parent_frame = "map";
-      p.child_frame = "base";
-      p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
-      p.y = 0.01;
-      bus_.publish(channels::kPoseFrontend, p);
-      if (i % kKeyEvery == 0) send_keys({i / kKeyEvery}, 0.0);
-      if (profiles && i % 3 == 0 && i + 2 <= n_poses) send_profile(p.utime);
-      handle_all();
-      mapper_->flush();
-    }
-  }
-
-  void TearDown() override { std::filesystem::remove_all(out_dir_); }
-
-  Bus bus_{"memq://"};
-  int64_t resend_max_bytes_ = mapper::PreviewConfig{}.resend_max_bytes;
-  std::filesystem::path out_dir_;
-  std::unique_ptr<densifier::DensifierNode> densifier_;
-  std::unique_ptr<mapper::MapperNode> mapper_;
-  std::vector<dense_segments_t> messages_;
-  std::vector<dense_segment_t> segments_;
-  std::vector<pose2d_t> dense_;
-  std::map<std::string, double> mapper_counters_;
-};
 
 TEST_P(GraphTest, CorrectedTrajectoryPlacesProfilesAndFollowsReoptimisation) {
   // 2 s at 0.5 m/s; the frontend is 1 cm north of the truth, the key poses are the truth.
@@ -323,130 +235,6 @@ TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
   EXPECT_EQ(mapper_counters_.at("annotation_level_changes"), 2.0);
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 7.0);
 }
-
-// The preview's points per profile time, as a viewer puts the parts of a profile together.
-std::map<int64_t, std::vector<std::array<int16_t, 3>>> preview_points(
-    const std::vector<cloud_preview_t>& messages) {
-  std::map<int64_t, std::vector<std::array<int16_t, 3>>> out;
-  for (const cloud_preview_t& m : messages) {
-    for (const preview_profile_t& p : m.profiles) {
-      for (int i = 0; i < p.n_points; ++i)
-        out[p.utime].push_back({p.x_mm[i], p.y_mm[i], p.z_mm[i]});
-    }
-  }
-  return out;
-}
-
-// A listener that starts late asks once for what came before (resend.hpp): the densifier answers
-// with the newest revision of every segment on DENSE_SEGMENTS_FULL, the mapper with every preview
-// point it sent (under its cap) on CLOUD_PREVIEW_FULL, and neither answer reaches the incremental
-// channels. The mapper, in turn, takes the annotator's answer on ANNOTATIONS_FULL like ANNOTATIONS.
-TEST_P(GraphTest, ALateListenerGetsEverySegmentAndPreviewProfileAgain) {
-  std::vector<cloud_preview_t> preview, preview_again;
-  std::vector<dense_segment_t> segments_again;
-  bus_.subscribe<cloud_preview_t>(channels::kCloudPreview,
-                                  [&](const cloud_preview_t& m) { preview.push_back(m); });
-  bus_.subscribe<cloud_preview_t>(channels::full_channel(channels::kCloudPreview),
-                                  [&](const cloud_preview_t& m) { preview_again.push_back(m); });
-  bus_.subscribe<dense_segments_t>(
-      channels::full_channel(channels::kDenseSegments), [&](const dense_segments_t& m) {
-        segments_again.insert(segments_again.end(), m.segments.begin(), m.segments.end());
-      });
-  drive(100, true);
-  send_keys({5, 6}, 0.05);  // segments 4 and 5 move: revision 1
-  handle_all();
-  mapper_->flush();
-  mapper_->publish_preview();
-  handle_all();
-  ASSERT_GT(preview.size(), 0u);
-  const std::size_t segments_sent = segments_.size();
-  EXPECT_TRUE(preview_again.empty() && segments_again.empty());  // nobody asked yet
-
-  request_resend(bus_, "test", {channels::kDenseSegments, channels::kCloudPreview});
-  handle_all();
-  mapper_->publish_preview();  // the mapper answers from its own thread, paced
-  handle_all();
-  EXPECT_EQ(segments_.size(), segments_sent);  // nothing more on DENSE_SEGMENTS
-  ASSERT_EQ(segments_again.size(), 6u);
-  for (std::size_t i = 0; i < segments_again.size(); ++i) {
-    EXPECT_EQ(segments_again[i].key_id_first, static_cast<int64_t>(i));
-    EXPECT_EQ(segments_again[i].revision, i >= 4 ? 1 : 0);
-  }
-  EXPECT_NEAR(segments_again[5].y.front(), 0.05, 1e-12);
-  EXPECT_EQ(preview_points(preview_again), preview_points(preview));
-
-  annotations_t a{};
-  a.utime = kT0;
-  a.parts = 1;
-  a.keys.resize(2);
-  a.keys[0].id = 0;
-  a.keys[0].utime = kT0;
-  a.keys[1].id = 1;
-  a.keys[1].utime = kT0 + kKeyEvery * kPoseDt;
-  a.n_keys = 2;
-  bus_.publish(channels::full_channel(channels::kAnnotations), a);
-  handle_all();
-  mapper_->report_counters();
-  EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 2.0);
-  EXPECT_EQ(mapper_counters_.at("resend_answers"), 1.0);
-  EXPECT_EQ(mapper_counters_.at("resend_requests"), 1.0);
-  EXPECT_EQ(mapper_counters_.at("resend_requests_sent"), 1.0);  // the annotations, at start
-}
-
-// The mapper keeps what it resends under preview.resend_max_bytes: after a run longer than that,
-// the late listener gets fewer points than were sent live, never more bytes than the cap, and
-// still the whole route, its start included (the earliest point of each coarser cell is kept).
-class SmallResendTest : public GraphTest {
- protected:
-  void SetUp() override {
-    resend_max_bytes_ = 4 << 10;
-    GraphTest::SetUp();
-  }
-};
-
-TEST_P(SmallResendTest, ALateListenerGetsTheWholeRouteUnderTheCap) {
-  std::vector<cloud_preview_t> preview, preview_again;
-  bus_.subscribe<cloud_preview_t>(channels::kCloudPreview,
-                                  [&](const cloud_preview_t& m) { preview.push_back(m); });
-  bus_.subscribe<cloud_preview_t>(channels::full_channel(channels::kCloudPreview),
-                                  [&](const cloud_preview_t& m) { preview_again.push_back(m); });
-  drive(300, true);  // 6 s, 3 m
-  mapper_->flush();
-  mapper_->publish_preview();
-  handle_all();
-  request_resend(bus_, "test", {channels::kCloudPreview});
-  handle_all();
-  mapper_->publish_preview();
-  handle_all();
-  const auto live = preview_points(preview), again = preview_points(preview_again);
-  int64_t live_points = 0, again_points = 0;
-  for (const auto& [t, pts] : live) live_points += static_cast<int64_t>(pts.size());
-  for (const auto& [t, pts] : again) {
-    again_points += static_cast<int64_t>(pts.size());
-    ASSERT_TRUE(live.count(t)) << t;  // points of profiles sent live, nothing made up
-    for (const auto& q : pts) {
-      EXPECT_NE(std::find(live.at(t).begin(), live.at(t).end(), q), live.at(t).end());
-    }
-  }
-  mapper_->report_counters();
-  RecordProperty("live_points", std::to_string(live_points));
-  RecordProperty("resent_points", std::to_string(again_points));
-  ASSERT_GT(live_points * 6, 2 * resend_max_bytes_);  // a run longer than the cap
-  EXPECT_GT(again_points, 0);
-  EXPECT_LT(again_points, live_points);
-  EXPECT_LE(mapper_counters_.at("preview_resend_bytes"), static_cast<double>(resend_max_bytes_));
-  EXPECT_LE(again_points * 6, resend_max_bytes_);
-  EXPECT_GT(mapper_counters_.at("preview_resend_compactions"), 0.0);
-  EXPECT_EQ(mapper_counters_.at("preview_resend_points_compacted"),
-            static_cast<double>(live_points - again_points));
-  // The start and the end of the route: the first profile (its points are the earliest of their
-  // cells), and one of the last second.
-  EXPECT_EQ(again.begin()->first, live.begin()->first);
-  EXPECT_GT(again.rbegin()->first, live.rbegin()->first - 1'000'000);
-}
-
-INSTANTIATE_TEST_SUITE_P(Mapper, SmallResendTest, ::testing::Values(true, false),
-                         [](const auto& info) { return info.param ? "worker" : "inline"; });
 
 INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "worker" : "inline"; });
