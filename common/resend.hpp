@@ -16,8 +16,8 @@
 // Answers are paced by data time (ResendPacing): an answer is a channel's whole state, and every
 // process on the multicast bus receives it, so a requester that asks in a loop must not make the
 // producer send it again and again. At most one answer per channel per kResendMinDataS of the
-// producer's data time (so a replay answers as the live run did); a request inside that stretch is
-// counted and dropped.
+// producer's data time (so a replay answers as the live run did), per channel or per requester
+// (ResendPacing::Scope); a request inside that stretch is counted and dropped.
 #pragma once
 
 #include <cstdint>
@@ -61,8 +61,9 @@ struct ResendPacing {
 };
 
 // Answers the requests that name any of `channels` (empty names: channels not published, never
-// answered). The answer function returns whether it answered (a producer may decline: the backend
-// answers at most once per stretch of data time).
+// answered), paced by `pacing`: the answer function gets the named channels outside their stretch
+// and returns whether it answered (a producer may decline: the backend with an empty graph); a
+// declined request starts no stretch.
 class ResendAnswerer {
  public:
   using Answer = std::function<bool(const ResendRequest& request)>;
