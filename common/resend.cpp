@@ -22,8 +22,12 @@ void request_resend(Publisher& bus, const std::string& requester,
   if (m.n_channels > 0) bus.publish(channels::kResendRequest, m);
 }
 
-ResendAnswerer::ResendAnswerer(Bus& bus, std::vector<std::string> channels, Answer answer)
-    : bus_(bus), channels_(std::move(channels)), answer_(std::move(answer)) {
+ResendAnswerer::ResendAnswerer(Bus& bus, std::vector<std::string> channels, Answer answer,
+                               ResendPacing pacing)
+    : bus_(bus),
+      channels_(std::move(channels)),
+      answer_(std::move(answer)),
+      pacing_(std::move(pacing)) {
   std::erase(channels_, std::string());
   if (channels_.empty()) return;
   subscription_ = bus_.subscribe_raw(
@@ -59,13 +63,33 @@ void ResendAnswerer::on_request(const uint8_t* data, int size) {
     last->second = m.seq;
   }
   ++counters_.requests;
-  if (answer_(r)) ++counters_.answers;
+  const bool paced = pacing_.min_us > 0 && pacing_.data_time;
+  const int64_t now = paced ? pacing_.data_time() : 0;
+  const auto key = [&](const std::string& channel) {
+    return pacing_.scope == ResendPacing::Scope::kChannel ? channel : m.requester + "\n" + channel;
+  };
+  if (paced) {
+    std::erase_if(r.named, [&](const std::string& channel) {
+      const auto last = last_answer_.find(key(channel));
+      return last != last_answer_.end() && now - last->second < pacing_.min_us;
+    });
+    if (r.named.empty()) {
+      ++counters_.paced;
+      return;
+    }
+  }
+  if (!answer_(r)) return;
+  ++counters_.answers;
+  if (paced) {
+    for (const std::string& channel : r.named) last_answer_[key(channel)] = now;
+  }
 }
 
 void ResendAnswerer::report(
     const std::function<void(const std::string& name, double value)>& sink) const {
   sink("resend_requests", static_cast<double>(counters_.requests));
   sink("resend_answers", static_cast<double>(counters_.answers));
+  sink("resend_requests_paced", static_cast<double>(counters_.paced));
   sink("resend_requests_repeated", static_cast<double>(counters_.repeated));
   sink("resend_requests_rejected", static_cast<double>(counters_.rejected));
 }

@@ -12,6 +12,12 @@
 // requests itself (same layout checks as the bus) and keeps a sequence number per requester: a
 // request that is no newer than the last one heard from its requester (a datagram delivered twice)
 // is counted and dropped, as is one that does not decode.
+//
+// Answers are paced by data time (ResendPacing): an answer is a channel's whole state, and every
+// process on the multicast bus receives it, so a requester that asks in a loop must not make the
+// producer send it again and again. At most one answer per channel per kResendMinDataS of the
+// producer's data time (so a replay answers as the live run did), per channel or per requester
+// (ResendPacing::Scope); a request inside that stretch is counted and dropped.
 #pragma once
 
 #include <cstdint>
@@ -38,13 +44,31 @@ struct ResendRequest {
   std::vector<std::string> named;  // the answerer's channels that it names, in its order
 };
 
+// [s] of a producer's data time between two answers on one channel (the backend's is its config's
+// graph_resend_min_s, 5 s by default).
+inline constexpr double kResendMinDataS = 5.0;
+
+struct ResendPacing {
+  // [us] of data time between two answers; 0 (or no data_time): every request answered
+  int64_t min_us = static_cast<int64_t>(kResendMinDataS * 1e6);
+  std::function<int64_t()> data_time;  // [us] the producer's newest data time
+  // Whose answer starts the stretch. kChannel: any requester's; the one answer goes to every
+  // listener (the backend: its listener asks again whenever something is still missing).
+  // kRequester: the same requester's; a requester not answered yet is answered, since it may not
+  // have been listening when the last answer went (the densifier and the annotator: their
+  // listeners, the viewer and the mapper, ask once, when they start).
+  enum class Scope { kChannel, kRequester } scope = Scope::kRequester;
+};
+
 // Answers the requests that name any of `channels` (empty names: channels not published, never
-// answered). The answer function returns whether it answered (a producer may decline: the backend
-// answers at most once per stretch of data time).
+// answered), paced by `pacing`: the answer function gets the named channels outside their stretch
+// and returns whether it answered (a producer may decline: the backend with an empty graph); a
+// declined request starts no stretch.
 class ResendAnswerer {
  public:
   using Answer = std::function<bool(const ResendRequest& request)>;
-  ResendAnswerer(Bus& bus, std::vector<std::string> channels, Answer answer);
+  ResendAnswerer(Bus& bus, std::vector<std::string> channels, Answer answer,
+                 ResendPacing pacing = {});
   ~ResendAnswerer();
   ResendAnswerer(const ResendAnswerer&) = delete;
   ResendAnswerer& operator=(const ResendAnswerer&) = delete;
@@ -52,11 +76,13 @@ class ResendAnswerer {
   struct Counters {
     int64_t requests = 0;  // well-formed, new, naming one of the channels
     int64_t answers = 0;   // of those, answered
+    int64_t paced = 0;     // of those, every channel named inside its stretch: dropped
     int64_t repeated = 0;  // not newer than the last from the same requester: dropped
     int64_t rejected = 0;  // did not decode: dropped
   };
   const Counters& counters() const { return counters_; }
-  // resend_requests, resend_answers, resend_requests_repeated, resend_requests_rejected.
+  // resend_requests, resend_answers, resend_requests_paced, resend_requests_repeated,
+  // resend_requests_rejected.
   void report(const std::function<void(const std::string& name, double value)>& sink) const;
 
  private:
@@ -65,8 +91,10 @@ class ResendAnswerer {
   Bus& bus_;
   std::vector<std::string> channels_;
   Answer answer_;
+  ResendPacing pacing_;
   Bus::Handle subscription_ = nullptr;
-  std::map<std::string, int64_t> last_seq_;  // by requester
+  std::map<std::string, int64_t> last_seq_;     // by requester
+  std::map<std::string, int64_t> last_answer_;  // [us] data time, by channel (and requester)
   Counters counters_;
 };
 

@@ -96,14 +96,18 @@ AnnotatorNode::AnnotatorNode(Bus& bus, const AnnotatorNodeConfig& config, Counte
       config_.key_poses_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
   // A late listener's answer: every annotation, as at the end of data but not final.
   resend_ = std::make_unique<ResendAnswerer>(
-      bus_, std::vector<std::string>{config_.annotations_channel}, [this](const ResendRequest&) {
+      bus_, std::vector<std::string>{config_.annotations_channel},
+      [this](const ResendRequest&) {
         const std::vector<Annotation> all = all_annotations();
         if (!all.empty()) {
           publish(all, annotations_t::REASON_NEW, 0,
                   channels::full_channel(config_.annotations_channel));
         }
         return true;
-      });
+      },
+      // Its listeners (the mapper, the viewer) ask once, at start: each requester is answered,
+      // at most once per kResendMinDataS of key pose time.
+      ResendPacing{.data_time = [this] { return utime_; }});
   if (!config_.ask_for_state) return;
   // The backend's answers: the whole graph, read like an update.
   bus_.subscribe<pose_graph_edges_t>(

@@ -51,26 +51,27 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
     bus_.subscribe<odometry_t>(config_.odometry_channel,
                                [this](const odometry_t& m) { on_odometry(m); });
   }
+  // The answer goes to every listener, and one that still lacks something asks again after the
+  // next optimisation: one answer per channel per graph_resend_min_s serves all who asked.
+  ResendPacing pacing{
+      std::llround(config_.graph_resend_min_s * 1e6),
+      [this] {
+        return published_.empty() ? int64_t{0} : backend_.key_poses()[published_.size() - 1].utime;
+      },
+      ResendPacing::Scope::kChannel};
   resend_ = std::make_unique<ResendAnswerer>(
       bus_, std::vector<std::string>{config_.edges_channel, config_.key_poses_channel},
-      [this](const ResendRequest& r) { return answer_resend(r); });
+      [this](const ResendRequest& r) { return answer_resend(r); }, std::move(pacing));
 }
 
 bool BackendNode::answer_resend(const ResendRequest& request) {
   // The graph as last published: key poses and edges added since wait for the next update.
   const std::size_t n_keys = published_.size();
-  // An empty graph needs no answer: the listener gets all of it from the updates to come. A
-  // request soon after an answer is dropped: the answer went to every listener, and one that
-  // still lacks something asks again after the next optimisation.
+  // An empty graph needs no answer: the listener gets all of it from the updates to come.
   if (n_keys == 0) return false;
-  const int64_t newest = backend_.key_poses()[n_keys - 1].utime;
-  const int64_t min_us = std::llround(config_.graph_resend_min_s * 1e6);
-  bool answered = false;
   // Edges first, as with the updates: a listener that has them when the key poses come can
   // compute its local bounds at once.
   for (const std::string& channel : request.named) {
-    auto last = last_answer_utime_.find(channel);
-    if (last != last_answer_utime_.end() && newest - last->second < min_us) continue;
     if (channel == config_.edges_channel) {
       publish_edges(0, edges_published_, last_update_.optimisation,
                     channels::full_channel(channel));
@@ -79,10 +80,8 @@ bool BackendNode::answer_resend(const ResendRequest& request) {
       std::iota(all.begin(), all.end(), 0);
       publish_key_poses(all, n_keys, last_update_, channels::full_channel(channel));
     }
-    last_answer_utime_[channel] = newest;
-    answered = true;
   }
-  return answered;
+  return true;
 }
 
 void BackendNode::on_odometry(const odometry_t& msg) {

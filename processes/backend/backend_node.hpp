@@ -42,10 +42,11 @@ struct BackendNodeConfig {
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
   std::string edges_channel = channels::kPoseGraphEdges;
-  double graph_resend_min_s = 5.0;   // [s] of data time between two answers on a _FULL channel
-  int max_poses_per_message = 400;   // 112 bytes each: 400 keep a part under 64 KB
-  double publish_move_m = 0.001;     // a key pose moved farther than this is republished [m]
-  double publish_turn_rad = 0.0005;  // ... or turned more than this [rad]
+  // [s] of data time between two answers on a _FULL channel (common/resend.hpp)
+  double graph_resend_min_s = kResendMinDataS;
+  int max_poses_per_message = 400;          // 112 bytes each: 400 keep a part under 64 KB
+  double publish_move_m = 0.001;            // a key pose moved farther than this is republished [m]
+  double publish_turn_rad = 0.0005;         // ... or turned more than this [rad]
   double publish_covariance_change = 0.01;  // ... or a variance changed by this fraction
   // With a state directory (traverse-backend --state-dir): a snapshot of the graph after an
   // optimisation once this much data time passed since the last (backend_state.hpp) [s].
@@ -126,7 +127,6 @@ class BackendNode {
   long messages_ = 0;
   std::size_t edges_published_ = 0;
   BackendUpdate last_update_;  // optimisation counter and time of the newest update
-  std::map<std::string, int64_t> last_answer_utime_;  // [us] newest key pose time, by channel
   std::unique_ptr<ResendAnswerer> resend_;
   std::optional<BackendStateStore> state_;
   std::optional<ResumedState> resumed_;

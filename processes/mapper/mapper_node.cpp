@@ -45,8 +45,9 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
     ++resend_requests_sent_;
   }
   if (preview_) {
-    resend_store_ =
-        std::make_unique<PreviewResend>(config_.preview.cell_m, config_.preview.resend_max_bytes);
+    // Live, a thinning pass runs on a thread of its own: this thread handles the messages.
+    resend_store_ = std::make_unique<PreviewResend>(
+        config_.preview.cell_m, config_.preview.resend_max_bytes, worker_thread);
     resend_ = std::make_unique<ResendAnswerer>(
         bus, std::vector<std::string>{config_.preview.channel}, [this](const ResendRequest&) {
           resend_store_->restart();  // from the start, paced by publish_preview()
@@ -211,6 +212,7 @@ void MapperNode::run_worker() {
 }
 
 void MapperNode::flush() {
+  if (resend_store_) resend_store_->wait();  // a thinning pass under way
   if (!worker_.joinable()) return;
   std::unique_lock lock(mutex_);
   idle_cv_.wait(lock, [this] { return done_ == submitted_; });
@@ -284,6 +286,7 @@ cloud_preview_t preview_message(const std::vector<PreviewProfile>& profiles, dou
 
 void MapperNode::publish_preview() {
   if (!preview_) return;
+  resend_store_->poll();  // a pass that has finished
   for (const std::vector<PreviewProfile>& group : preview_->take()) {
     cloud_preview_t m = preview_message(group, config_.preview.cell_m);
     bus_.publish(config_.preview.channel, m);
@@ -370,6 +373,7 @@ void MapperNode::report_counters() {
     counters_("preview_resend_compactions", static_cast<double>(r.compactions));
     counters_("preview_resend_points_compacted", static_cast<double>(r.points_compacted));
     counters_("preview_resend_compact_max_s", r.compact_max_s);
+    counters_("preview_resend_blocked_max_s", r.blocked_max_s);
   }
 }
 

@@ -16,9 +16,10 @@
 // publish_preview() (640 KB/s) so as not to overflow the sockets of the viewer or of the other
 // processes, which receive every multicast message. What is kept for that is capped
 // (preview.resend_max_bytes) and thinned to a coarser grid beyond the cap (preview_resend.hpp), so
-// it follows the map, not the run. In turn the node asks the annotator for every annotation when
-// it starts (ANNOTATIONS_FULL), so a mapper started after the annotator colours its points at
-// once, not grey until the end of data.
+// it follows the map, not the run; live, a thinning pass runs on a thread of its own, so this
+// thread's message handling never waits for it. In turn the node asks the annotator for every
+// annotation when it starts (ANNOTATIONS_FULL), so a mapper started after the annotator colours its
+// points at once, not grey until the end of data.
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
@@ -76,7 +77,8 @@ class MapperNode {
   MapperNode(const MapperNode&) = delete;
   MapperNode& operator=(const MapperNode&) = delete;
 
-  // Waits until everything received so far is in the map (moves applied).
+  // Waits until everything received so far is in the map (moves applied) and a thinning pass of
+  // the preview kept for late viewers is done.
   void flush();
   // Writes cloud.ply, map.bt, map.ot and map_colour.ot into the output folder (after a flush);
   // false (and why) on failure.

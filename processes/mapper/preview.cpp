@@ -12,7 +12,7 @@ std::optional<std::string> validate(const PreviewConfig& c) {
   // 21 bits per axis: 2^20 cells either side of the origin.
   check.in_range("cell_m", c.cell_m, 0.001, 100.0);
   check.in_range("max_points_per_message", c.max_points_per_message, 1, 10000);
-  check.in_range("resend_max_bytes", c.resend_max_bytes, int64_t{1} << 10, int64_t{1} << 40);
+  check.in_range("resend_max_bytes", c.resend_max_bytes, int64_t{1} << 10, int64_t{1} << 34);
   return check.problem();
 }
 
@@ -26,6 +26,17 @@ std::optional<uint64_t> preview_cell(double x, double y, double z, double cell_m
   }
   return static_cast<uint64_t>(ix) | static_cast<uint64_t>(iy) << 21 |
          static_cast<uint64_t>(iz) << 42;
+}
+
+uint64_t preview_cell_doubled(uint64_t cell) {
+  // i = floor(x / c) + 2^20, and floor(x / 2c) = floor(floor(x / c) / 2) (halving is exact in
+  // floating point too): i' = floor((i - 2^20) / 2) + 2^20 = (i >> 1) + 2^19.
+  constexpr uint64_t kAxis = (uint64_t{1} << 21) - 1;
+  uint64_t out = 0;
+  for (int shift = 0; shift < 63; shift += 21) {
+    out |= (((cell >> shift & kAxis) >> 1) + (uint64_t{1} << 19)) << shift;
+  }
+  return out;
 }
 
 CloudPreview::CloudPreview(const PreviewConfig& config) : config_(config) {}

@@ -32,7 +32,8 @@ struct PreviewConfig {
   int max_points_per_message = 9000;      // 6 bytes each: a message stays under 64 KB
   // [bytes] what the mapper keeps of the preview to answer a late viewer (preview_resend.hpp):
   // beyond it the kept points are thinned to a coarser grid, so memory follows the map's extent,
-  // not the run's length. 8 MiB: about 1.3 million points.
+  // not the run's length. 8 MiB: about 1.3 million points. At most 16 GiB (a thinning pass numbers
+  // the points kept in 32 bits).
   int64_t resend_max_bytes = 8 << 20;
 
   template <class V>
@@ -56,6 +57,9 @@ struct PreviewProfile {
 // The cell of a grid of edge cell_m [m] that holds world point (x, y, z) [m], packed into 63 bits
 // (21 per axis: 2^20 cells either side of the origin); nullopt outside that range.
 std::optional<uint64_t> preview_cell(double x, double y, double z, double cell_m);
+// The cell of the grid of edge 2 cell_m that holds the whole of `cell` (a preview_cell() at
+// cell_m): the same as preview_cell() of any of its points at 2 cell_m, from the indices alone.
+uint64_t preview_cell_doubled(uint64_t cell);
 
 // Thread-safe: add() on the mapper's thread, take() on the publishing one.
 class CloudPreview {

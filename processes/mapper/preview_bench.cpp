@@ -59,6 +59,9 @@ int main(int argc, char** argv) {
   app.add_option("--every", every_s, "[s] of data between two printed lines");
   app.add_option("--resend-max-bytes", preview_config.resend_max_bytes, "[bytes] the cap");
   app.add_option("--coverage-cell", coverage_cell_m, "[m] 2D cells the coverage is counted in");
+  bool inline_thinning = false;
+  app.add_flag("--inline-thinning", inline_thinning,
+               "thin inside add() (offline) instead of on a thread of its own (live)");
   traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
 
@@ -72,13 +75,17 @@ int main(int argc, char** argv) {
   tm::CloudPreview preview(preview_config);
   mapper.on_first_placement(
       [&](int64_t t, const traverse::Pose2& T, const auto& pts) { preview.add(t, T, pts); });
-  tm::PreviewResend resend(preview_config.cell_m, preview_config.resend_max_bytes);
+  // As the live node: the passes on a thread of their own, merged once a second (--inline-thinning:
+  // inside add(), as the node does offline).
+  tm::PreviewResend resend(preview_config.cell_m, preview_config.resend_max_bytes,
+                           !inline_thinning);
   std::vector<tm::PreviewProfile> everything;  // every profile sent live, for the coverage
   int64_t sent_bytes = 0, sent_points = 0, kept_max = 0, first_utime = -1, next_take = 0,
           next_print = 0;
   tm::TrajectorySegment open;
   const auto t0 = std::chrono::steady_clock::now();
   const auto take = [&] {
+    resend.poll();
     for (auto& group : preview.take()) {
       sent_bytes += message_bytes(group);
       for (auto& p : group) {
@@ -125,6 +132,7 @@ int main(int argc, char** argv) {
   }
   mapper.set_segment(open);
   take();
+  resend.wait();
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double data_s = next_take;
@@ -148,16 +156,18 @@ int main(int argc, char** argv) {
   std::printf(
       "%.0f s of data (%.0f s wall): every preview message kept %.2f MB (%lld points); "
       "the capped store %.2f MB (cap %.2f MB, largest %.2f MB), %lld points at one per "
-      "%.2f m cell; %lld points thinned in %lld passes (longest %.3f s); a late viewer "
-      "gets %lld points in %.2f MB, in %.1f %% of the %zu %.1f m cells of the route's "
+      "%.2f m cell; %lld points thinned in %lld passes (longest %.1f ms, all %.1f ms wall; the "
+      "caller held up %.2f ms at most, %.2f ms in all); a late "
+      "viewer gets %lld points in %.2f MB, in %.1f %% of the %zu %.1f m cells of the route's "
       "preview\n",
       data_s, wall_s, sent_bytes / 1e6, static_cast<long long>(sent_points), resend.bytes() / 1e6,
       preview_config.resend_max_bytes / 1e6, kept_max / 1e6,
       static_cast<long long>(resend.points()), resend.cell_m(),
       static_cast<long long>(resend.counters().points_compacted),
-      static_cast<long long>(resend.counters().compactions), resend.counters().compact_max_s,
-      static_cast<long long>(answer_points), answer_bytes / 1e6, 100 * coverage, all_cells.size(),
-      coverage_cell_m);
+      static_cast<long long>(resend.counters().compactions), 1e3 * resend.counters().compact_max_s,
+      1e3 * resend.counters().compact_total_s, 1e3 * resend.counters().blocked_max_s,
+      1e3 * resend.counters().blocked_total_s, static_cast<long long>(answer_points),
+      answer_bytes / 1e6, 100 * coverage, all_cells.size(), coverage_cell_m);
   using traverse::json_fixed;
   traverse::Json j;
   j["bench"] = "preview";
@@ -172,8 +182,14 @@ int main(int argc, char** argv) {
   j["resend_cell_m"] = json_fixed(resend.cell_m(), 3);
   j["compactions"] = static_cast<long long>(resend.counters().compactions);
   j["points_compacted"] = static_cast<long long>(resend.counters().points_compacted);
-  j["compact_max_s"] = json_fixed(resend.counters().compact_max_s, 4);
-  j["compact_total_s"] = json_fixed(resend.counters().compact_total_s, 3);
+  // [ms] wall time of the longest thinning pass and of all of them, wherever they ran.
+  j["compact_max_ms"] = json_fixed(1e3 * resend.counters().compact_max_s, 1);
+  j["compact_total_ms"] = json_fixed(1e3 * resend.counters().compact_total_s, 1);
+  // [ms] what thinning held up the thread that adds (the mapper's message thread), at worst and
+  // in all: the whole pass inline, the hand-over and the merge on a thread of its own.
+  j["thinning"] = inline_thinning ? "inline" : "background";
+  j["compact_blocked_max_ms"] = json_fixed(1e3 * resend.counters().blocked_max_s, 2);
+  j["compact_blocked_total_ms"] = json_fixed(1e3 * resend.counters().blocked_total_s, 2);
   j["answer_points"] = static_cast<long long>(answer_points);
   j["answer_bytes"] = static_cast<long long>(answer_bytes);
   j["coverage_cell_m"] = json_fixed(coverage_cell_m, 2);

@@ -2,23 +2,34 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <unordered_set>
+#include <limits>
 
 namespace traverse::mapper {
 
-PreviewResend::PreviewResend(double cell_m, int64_t max_bytes)
-    : cell_m_(cell_m), max_bytes_(max_bytes) {}
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+PreviewResend::PreviewResend(double cell_m, int64_t max_bytes, bool background)
+    : cell_m_(cell_m), max_bytes_(max_bytes), background_(background) {}
+
+PreviewResend::~PreviewResend() {
+  if (pass_.valid()) pass_.wait();
+}
 
 int64_t PreviewResend::bytes() const {
-  return points_ * static_cast<int64_t>(sizeof(std::array<int16_t, 3>)) +
-         static_cast<int64_t>(kept_.size()) * kProfileBytes;
+  return points_ * kKeptPointBytes +
+         static_cast<int64_t>(kept_.size() + pass_profiles_) * kKeptProfileBytes;
 }
 
 void PreviewResend::add(const PreviewProfile& profile) {
   if (profile.p_base_mm.empty()) return;
   auto [it, fresh] = kept_.try_emplace(profile.utime);
-  Kept& k = it->second;
+  KeptProfile& k = it->second;
   if (fresh) {
     k.x = static_cast<float>(profile.T_world_base.x());
     k.y = static_cast<float>(profile.T_world_base.y());
@@ -27,22 +38,102 @@ void PreviewResend::add(const PreviewProfile& profile) {
   k.p_base_mm.reserve(k.p_base_mm.size() + profile.p_base_mm.size());
   k.p_base_mm.insert(k.p_base_mm.end(), profile.p_base_mm.begin(), profile.p_base_mm.end());
   points_ += static_cast<int64_t>(profile.p_base_mm.size());
-  if (bytes() > max_bytes_) compact();
+  if (bytes() > max_bytes_ && !pass_.valid()) start_pass();
+}
+
+PreviewResend::Pass PreviewResend::run(KeptProfiles kept, double cell_m, int64_t max_bytes) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Pass pass{std::move(kept), 0, 0, 0};
+  pass.cell_m = thin_earliest_per_cell(pass.kept, cell_m, max_bytes);
+  for (const auto& [utime, k] : pass.kept) pass.points += static_cast<int64_t>(k.p_base_mm.size());
+  pass.seconds = seconds_since(t0);
+  return pass;
+}
+
+void PreviewResend::start_pass() {
+  const auto t0 = std::chrono::steady_clock::now();
+  pass_profiles_ = kept_.size();
+  pass_points_ = points_;
+  KeptProfiles given = std::move(kept_);
+  kept_.clear();  // what arrives from now on
+  if (background_) {
+    pass_ = std::async(std::launch::async, [given = std::move(given), cell_m = cell_m_,
+                                            max_bytes = max_bytes_]() mutable {
+      return run(std::move(given), cell_m, max_bytes);
+    });
+  } else {
+    merge(run(std::move(given), cell_m_, max_bytes_));
+  }
+  count_blocked(seconds_since(t0));
+}
+
+bool PreviewResend::poll() {
+  if (!pass_.valid() || pass_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    return false;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  merge(pass_.get());
+  count_blocked(seconds_since(t0));
+  return true;
+}
+
+void PreviewResend::wait() {
+  while (pass_.valid()) {
+    merge(pass_.get());
+    // What arrived during the pass may have filled the store again.
+    if (bytes() > max_bytes_) start_pass();
+  }
+}
+
+void PreviewResend::merge(Pass pass) {
+  ++counters_.compactions;
+  counters_.points_compacted += pass_points_ - pass.points;
+  counters_.profiles_compacted += static_cast<int64_t>(pass_profiles_ - pass.kept.size());
+  counters_.compact_total_s += pass.seconds;
+  counters_.compact_max_s = std::max(counters_.compact_max_s, pass.seconds);
+  // What arrived meanwhile goes after the thinned store; a part of a profile in it joins it.
+  int64_t points = pass.points;
+  for (auto& [utime, k] : kept_) {
+    points += static_cast<int64_t>(k.p_base_mm.size());
+    auto [it, fresh] = pass.kept.try_emplace(utime, std::move(k));
+    if (!fresh) {
+      it->second.p_base_mm.insert(it->second.p_base_mm.end(), k.p_base_mm.begin(),
+                                  k.p_base_mm.end());
+    }
+  }
+  kept_ = std::move(pass.kept);
+  points_ = points;
+  cell_m_ = pass.cell_m;
+  pass_profiles_ = 0;
+  pass_points_ = 0;
+  // An answer under way that was inside a profile goes on with the next one: the thinned
+  // profile's points are no longer where they were.
+  if (resending_ && next_point_ > 0) {
+    const auto it = kept_.upper_bound(next_utime_);
+    next_point_ = 0;
+    resending_ = it != kept_.end();
+    if (resending_) next_utime_ = it->first;
+  }
+}
+
+void PreviewResend::count_blocked(double s) {
+  counters_.blocked_total_s += s;
+  counters_.blocked_max_s = std::max(counters_.blocked_max_s, s);
 }
 
 void PreviewResend::restart() {
-  resending_ = !kept_.empty();
-  next_utime_ = kept_.empty() ? 0 : kept_.begin()->first;
+  resending_ = points_ > 0;
+  next_utime_ = std::numeric_limits<int64_t>::min();
   next_point_ = 0;
 }
 
 std::vector<PreviewProfile> PreviewResend::next(std::size_t max_points) {
   std::vector<PreviewProfile> out;
-  if (!resending_) return out;
+  if (!resending_ || pass_.valid()) return out;
   std::size_t n = 0;
   auto it = kept_.lower_bound(next_utime_);
   while (it != kept_.end() && n < max_points) {
-    const Kept& k = it->second;
+    const KeptProfile& k = it->second;
     const std::size_t take = std::min(max_points - n, k.p_base_mm.size() - next_point_);
     const auto first = k.p_base_mm.begin() + static_cast<std::ptrdiff_t>(next_point_);
     out.push_back(
@@ -57,54 +148,6 @@ std::vector<PreviewProfile> PreviewResend::next(std::size_t max_points) {
   resending_ = it != kept_.end();
   if (resending_) next_utime_ = it->first;
   return out;
-}
-
-void PreviewResend::compact() {
-  const auto t0 = std::chrono::steady_clock::now();
-  const int64_t before_points = points_;
-  const std::size_t before_profiles = kept_.size();
-  thin();
-  while (bytes() > max_bytes_ / 2 && cell_m_ < 1e3) {
-    cell_m_ *= 2.0;
-    thin();
-  }
-  // An answer under way that was inside a profile goes on with the next one: the thinned
-  // profile's points are no longer where they were.
-  if (resending_ && next_point_ > 0) {
-    const auto it = kept_.upper_bound(next_utime_);
-    next_point_ = 0;
-    resending_ = it != kept_.end();
-    if (resending_) next_utime_ = it->first;
-  }
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  ++counters_.compactions;
-  counters_.points_compacted += before_points - points_;
-  counters_.profiles_compacted += static_cast<int64_t>(before_profiles - kept_.size());
-  counters_.compact_total_s += s;
-  counters_.compact_max_s = std::max(counters_.compact_max_s, s);
-}
-
-void PreviewResend::thin() {
-  std::unordered_set<uint64_t> taken;
-  taken.reserve(static_cast<std::size_t>(points_));
-  points_ = 0;
-  for (auto it = kept_.begin(); it != kept_.end();) {
-    Kept& k = it->second;
-    const double c = std::cos(k.theta), s = std::sin(k.theta);
-    std::erase_if(k.p_base_mm, [&](const std::array<int16_t, 3>& q) {
-      const double bx = q[0] * 1e-3, by = q[1] * 1e-3;
-      const std::optional<uint64_t> cell =
-          preview_cell(k.x + c * bx - s * by, k.y + s * bx + c * by, q[2] * 1e-3, cell_m_);
-      return !cell || !taken.insert(*cell).second;
-    });
-    if (k.p_base_mm.empty()) {
-      it = kept_.erase(it);
-      continue;
-    }
-    k.p_base_mm.shrink_to_fit();
-    points_ += static_cast<int64_t>(k.p_base_mm.size());
-    ++it;
-  }
 }
 
 }  // namespace traverse::mapper

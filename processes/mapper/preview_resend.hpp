@@ -2,13 +2,19 @@
 // the answer goes on CLOUD_PREVIEW_FULL). Keeping every preview message sent costs about 6 bytes
 // a point, tens of MB on a whole route, and grows with the run. A late viewer needs a picture of
 // the whole map, not every point: so the points kept are capped (resend_max_bytes), and when they
-// pass the cap they are thinned on a coarser grid: of the points in one cell of that grid, the
-// earliest is kept (so the start of the route stays as it was). A pass thins at the current grid
-// first (what came since the last pass), and doubles the cell while more than half the cap is
-// left, so the next pass is at least half a cap of new points away (each point is thinned a
-// bounded number of times on average). The grid doubles only when the map outgrows the cap at
-// that cell size: what is kept follows the surface mapped, at about one point per cell of a grid
-// that coarsens as the map grows, never the time spent.
+// pass the cap they are thinned on a coarser grid (preview_thinning.hpp): of the points in one
+// cell of that grid, the earliest is kept (so the start of the route stays as it was). A pass
+// doubles the cell while more than half the cap is left, so the next pass is at least half a cap
+// of new points away (each point is thinned a bounded number of times on average). The grid
+// doubles only when the map outgrows the cap at that cell size: what is kept follows the surface
+// mapped, at about one point per cell of a grid that coarsens as the map grows, never the time
+// spent.
+//
+// A pass over a full 8 MiB store takes a few hundred milliseconds. In the background mode (the
+// live node) it runs on a thread of its own: add() hands the store over (a move) and keeps what
+// arrives meanwhile apart; poll() merges the thinned store back when the pass is done. The
+// caller's thread waits for neither, and an answer under way pauses while a pass runs. Without
+// it (offline, tests) the pass runs inside add().
 //
 // Cells are chosen with the pose each profile was first placed with, like the preview's own
 // (preview.hpp); the points sent are unchanged, in the base frame at the profile's time, so a
@@ -17,10 +23,11 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <map>
+#include <future>
 #include <vector>
 
 #include "preview.hpp"
+#include "preview_thinning.hpp"
 
 namespace traverse::mapper {
 
@@ -28,46 +35,68 @@ struct PreviewResendCounters {
   int64_t compactions = 0;         // thinning passes
   int64_t points_compacted = 0;    // points dropped from what is kept, over all passes
   int64_t profiles_compacted = 0;  // profiles left with no point, dropped
-  double compact_total_s = 0;      // [s] wall time spent thinning
+  double compact_total_s = 0;      // [s] wall time of the passes, wherever they ran
   double compact_max_s = 0;        // [s] the longest pass
+  // [s] what thinning held up the caller of add() and poll(), in all and at worst: the whole
+  // pass without the background mode, handing over and merging back with it.
+  double blocked_total_s = 0;
+  double blocked_max_s = 0;
 };
 
 class PreviewResend {
  public:
-  // `cell_m` [m]: the preview's grid; `max_bytes` [bytes]: the cap on bytes().
-  PreviewResend(double cell_m, int64_t max_bytes);
+  // `cell_m` [m]: the preview's grid; `max_bytes` [bytes]: the cap on bytes(); `background`: the
+  // passes run on a thread of their own (then call poll() now and then).
+  PreviewResend(double cell_m, int64_t max_bytes, bool background = false);
+  ~PreviewResend();  // waits for a pass under way
+  PreviewResend(const PreviewResend&) = delete;
+  PreviewResend& operator=(const PreviewResend&) = delete;
 
   // A profile's preview points as sent live (parts of one profile, same utime, are merged).
   void add(const PreviewProfile& profile);
+  // Merges a background pass that has finished; true when there was one.
+  bool poll();
+  // Waits for a background pass under way, if any, merges it, and passes again while the store is
+  // over its cap (not counted as blocked: the node never waits; the end of a bench or test does).
+  void wait();
+  bool thinning() const { return pass_.valid(); }
   // A late listener asked: next() goes through everything kept from the oldest profile again.
   void restart();
   bool resending() const { return resending_; }
   // The next kept profiles of the answer in time order, at most `max_points` points (a profile
-  // with more continues in the next call); empty when the answer is complete.
+  // with more continues in the next call); empty when the answer is complete or paused while a
+  // pass runs.
   std::vector<PreviewProfile> next(std::size_t max_points);
 
   double cell_m() const { return cell_m_; }  // [m] the grid the kept points are one per cell of
   int64_t points() const { return points_; }
-  std::size_t profiles() const { return kept_.size(); }
+  std::size_t profiles() const { return kept_.size() + pass_profiles_; }
   // [bytes] heap held: 6 bytes a point and the bookkeeping of each profile.
   int64_t bytes() const;
   const PreviewResendCounters& counters() const { return counters_; }
 
-  // What a kept profile costs besides its points (its map node and record) [bytes].
-  static constexpr int64_t kProfileBytes = 96;
-
  private:
-  struct Kept {
-    float x = 0, y = 0, theta = 0;  // [m, m, rad] the first placement's pose (chooses cells)
-    std::vector<std::array<int16_t, 3>> p_base_mm;
+  struct Pass {
+    KeptProfiles kept;
+    double cell_m = 0;   // [m] the grid it ended at
+    int64_t points = 0;  // in `kept`
+    double seconds = 0;  // [s] wall time of the pass
   };
-  void compact();
-  void thin();  // one point per cell of cell_m_, the earliest
+  // A thinning pass over `kept` (touches nothing else: it may run on another thread).
+  static Pass run(KeptProfiles kept, double cell_m, int64_t max_bytes);
+  void start_pass();
+  // The pass's result in place of what it was given, what arrived meanwhile added after it.
+  void merge(Pass pass);
+  void count_blocked(double s);
 
   double cell_m_;
   int64_t max_bytes_;
-  std::map<int64_t, Kept> kept_;  // by utime
-  int64_t points_ = 0;
+  bool background_;
+  KeptProfiles kept_;   // with a pass under way: what arrived since it started
+  int64_t points_ = 0;  // kept_'s and the pass's
+  std::future<Pass> pass_;
+  std::size_t pass_profiles_ = 0;  // profiles handed to the pass under way
+  int64_t pass_points_ = 0;        // ... and their points
   bool resending_ = false;
   int64_t next_utime_ = 0;      // [us] the answer's next profile
   std::size_t next_point_ = 0;  // ... and its first point not yet sent

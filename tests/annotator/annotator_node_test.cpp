@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <functional>
 #include <map>
 #include <set>
 
@@ -43,6 +45,7 @@ class AnnotatorNodeTest : public ::testing::Test {
     for (std::size_t k = 0; k < d.utimes.size(); ++k) {
       backend::test::publish_drive_step(bus_, d, k);
       handle_all();
+      if (on_step_) on_step_(annotator);
     }
     if (ask_) {  // a listener that started late, before the end of data
       const std::size_t before = messages_.size();
@@ -75,6 +78,7 @@ class AnnotatorNodeTest : public ::testing::Test {
   std::vector<Pose2> backend_poses_;
   std::size_t backend_edges_ = 0, closures_ = 0;
   bool ask_ = false;
+  std::function<void(const AnnotatorNode&)> on_step_;  // after each step of the drive
   std::vector<annotations_t> full_;  // the answer to a late listener (ANNOTATIONS_FULL)
   std::size_t annotated_when_asked_ = 0, answer_on_incremental_ = 0;
 };
@@ -94,6 +98,47 @@ TEST_F(AnnotatorNodeTest, ALateListenerGetsEveryAnnotation) {
   EXPECT_EQ(ids.size(), annotated_when_asked_);
   EXPECT_EQ(answer_on_incremental_, 0u);
   EXPECT_EQ(counters_.at("resend_answers"), 1.0);
+}
+
+// Requests are paced by key pose time (common/resend.hpp): a burst from one requester gets one
+// answer per kResendMinDataS (5 s), and a requester not answered yet is answered inside that
+// stretch. The data time is the newest ANNOTATIONS message's (the annotator's newest key pose).
+TEST_F(AnnotatorNodeTest, ABurstGetsOneAnswerPerStretchAndANewRequesterIsAnswered) {
+  const auto answers = [this] {
+    return std::count_if(full_.begin(), full_.end(),
+                         [](const annotations_t& m) { return m.part == 0; });
+  };
+  const auto ask = [this](const std::string& who) {
+    request_resend(bus_, who, {channels::kAnnotations});
+    handle_all();
+  };
+  int64_t answered_at = -1;  // [us] data time of the first answer
+  int step = 0;
+  on_step_ = [&](const AnnotatorNode& node) {
+    if (node.annotator().annotations().size() < 5 || messages_.empty()) return;
+    const int64_t now = messages_.back().utime;
+    if (step == 0) {
+      for (int k = 0; k < 4; ++k) ask("viewer");
+      EXPECT_EQ(answers(), 1);
+      ask("mapper");  // not answered yet
+      EXPECT_EQ(answers(), 2);
+      answered_at = now;
+      step = 1;
+    } else if (step == 1 && now - answered_at >= 2'000'000) {
+      ask("viewer");  // inside its stretch
+      EXPECT_EQ(answers(), 2);
+      step = 2;
+    } else if (step == 2 && now - answered_at >= 6'000'000) {
+      ask("viewer");
+      EXPECT_EQ(answers(), 3);
+      step = 3;
+    }
+  };
+  run(AnnotatorNodeConfig{});
+  EXPECT_EQ(step, 3);  // the drive was long enough for every step
+  EXPECT_EQ(counters_.at("resend_requests"), 7.0);
+  EXPECT_EQ(counters_.at("resend_answers"), 3.0);
+  EXPECT_EQ(counters_.at("resend_requests_paced"), 4.0);
 }
 
 TEST_F(AnnotatorNodeTest, RebuildsTheBackendsGraphAndCoversEveryKeyPose) {

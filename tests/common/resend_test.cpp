@@ -1,11 +1,13 @@
 // The graph's one late-joining mechanism (resend.hpp): a producer answers the requests that name
 // its channels, once per request; a request delivered twice, or one that does not decode, is
-// counted and dropped, and the producer keeps answering the next ones.
+// counted and dropped, and the producer keeps answering the next ones. Answers are paced by the
+// producer's data time, per channel or per requester.
 #include "resend.hpp"
 
 #include <gtest/gtest.h>
 
 #include <map>
+#include <memory>
 
 #include "channels.hpp"
 #include "traverse/resend_request_t.hpp"
@@ -112,6 +114,49 @@ TEST(LateJoinResend, ARestartedRequesterIsANewOne) {
   handle_all(bus);
   EXPECT_EQ(answers, 2);
   EXPECT_EQ(answerer.counters().repeated, 1);
+}
+
+TEST(LateJoinResend, PacesAnswersByDataTimePerRequesterOrPerChannel) {
+  Bus bus("memq://");
+  int64_t now = 10'000'000;  // [us] the producers' data time
+  bool decline = false;
+  std::map<std::string, int> answers;  // by producer
+  const auto answerer = [&](const std::string& channel, ResendPacing::Scope scope) {
+    return std::make_unique<ResendAnswerer>(
+        bus, std::vector<std::string>{channel},
+        [&, channel](const ResendRequest&) {
+          if (decline) return false;
+          ++answers[channel];
+          return true;
+        },
+        ResendPacing{.data_time = [&] { return now; }, .scope = scope});
+  };
+  const auto per_requester = answerer("SEGMENTS", ResendPacing::Scope::kRequester);
+  const auto per_channel = answerer("KEYS", ResendPacing::Scope::kChannel);
+  const auto ask = [&](const std::string& who) {
+    request_resend(bus, who, {"SEGMENTS", "KEYS"});
+    handle_all(bus);
+  };
+  decline = true;  // a declined request starts no stretch
+  ask("a");
+  decline = false;
+  ask("a");
+  ask("a");  // inside a's stretch on both
+  ask("b");  // a new requester: answered per requester, not per channel
+  EXPECT_EQ(answers["SEGMENTS"], 2);
+  EXPECT_EQ(answers["KEYS"], 1);
+  now += 4'999'999;
+  ask("a");
+  EXPECT_EQ(answers["SEGMENTS"], 2);
+  EXPECT_EQ(answers["KEYS"], 1);
+  now += 1;  // 5 s after the first answers
+  ask("a");
+  EXPECT_EQ(answers["SEGMENTS"], 3);
+  EXPECT_EQ(answers["KEYS"], 2);
+  EXPECT_EQ(per_requester->counters().requests, 6);
+  EXPECT_EQ(per_requester->counters().paced, 2);
+  EXPECT_EQ(per_channel->counters().paced, 3);
+  EXPECT_EQ(per_channel->counters().answers, 2);
 }
 
 TEST(LateJoinResend, AProducerWithoutTheChannelAnswersNothing) {

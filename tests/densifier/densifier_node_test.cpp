@@ -1,8 +1,13 @@
 // Packing of segments into DENSE_SEGMENTS messages: in order, each message under the size limit
-// unless one segment alone is larger (then it travels alone), parts numbered 0..parts-1.
+// unless one segment alone is larger (then it travels alone), parts numbered 0..parts-1. A late
+// listener's requests are answered on DENSE_SEGMENTS_FULL, paced by frontend time.
 #include "densifier_node.hpp"
 
 #include <gtest/gtest.h>
+
+#include <map>
+
+#include "channels.hpp"
 
 namespace traverse::densifier {
 namespace {
@@ -65,6 +70,72 @@ TEST(PackSegments, SegmentLargerThanTheLimitTravelsAlone) {
 
 TEST(PackSegments, NothingToSendGivesNoMessage) {
   EXPECT_TRUE(pack_segments({}, "world", "base", 0, 60000).empty());
+}
+
+// A burst of requests from one requester gets one answer per kResendMinDataS (5 s) of frontend
+// time (common/resend.hpp); a requester not answered yet is answered inside that stretch.
+TEST(DensifierNodeResend, ABurstGetsOneAnswerPerStretchAndANewRequesterIsAnswered) {
+  Bus bus("memq://");
+  std::map<std::string, double> counters;
+  DensifierNode node(bus, DensifierConfig{},
+                     [&](const std::string& k, double v) { counters[k] = v; });
+  int answers = 0, answered_segments = 0;  // answers on DENSE_SEGMENTS_FULL, the first's segments
+  bus.subscribe<dense_segments_t>(
+      channels::full_channel(channels::kDenseSegments),
+      [&](const dense_segments_t& m) {
+        answers += m.part == 0;
+        if (answers == 1) answered_segments += m.n_segments;
+      },
+      true);
+  const auto handle_all = [&] {
+    while (bus.lcm().handleTimeout(0) > 0) {
+    }
+  };
+  constexpr int64_t kDt = 100'000;  // [us] frontend poses at 10 Hz, a key pose a second
+  const auto drive = [&](int from, int to) {
+    for (int i = from; i < to; ++i) {
+      pose2d_t p{};
+      p.utime = i * kDt;
+      p.parent_frame = "map";
+      p.child_frame = "base";
+      p.x = 0.05 * i;  // [m] 0.5 m/s along x
+      bus.publish(channels::kPoseFrontend, p);
+      if (i % 10 == 0) {
+        key_poses_t k{};
+        k.utime = p.utime;
+        k.optimisation = i / 10 + 1;
+        k.parts = 1;
+        key_pose_t pose{};
+        pose.utime = p.utime;
+        pose.id = i / 10;
+        pose.x = p.x;
+        k.poses.push_back(pose);
+        k.n_poses = 1;
+        bus.publish(channels::kKeyPoses, k);
+      }
+      handle_all();
+    }
+  };
+  const auto ask = [&](const std::string& who) {
+    request_resend(bus, who, {channels::kDenseSegments});
+    handle_all();
+  };
+  drive(0, 60);  // 5.9 s of data, five segments closed
+  for (int k = 0; k < 4; ++k) ask("viewer");
+  EXPECT_EQ(answers, 1);
+  EXPECT_GE(answered_segments, 4);
+  ask("second-viewer");  // not answered yet: answered inside the first one's stretch
+  EXPECT_EQ(answers, 2);
+  drive(60, 100);  // 4 s after the answer: still inside the stretch
+  ask("viewer");
+  EXPECT_EQ(answers, 2);
+  drive(100, 120);  // 6 s after
+  ask("viewer");
+  EXPECT_EQ(answers, 3);
+  node.report_counters();
+  EXPECT_EQ(counters.at("resend_requests"), 7.0);
+  EXPECT_EQ(counters.at("resend_answers"), 3.0);
+  EXPECT_EQ(counters.at("resend_requests_paced"), 4.0);
 }
 
 }  // namespace

@@ -108,6 +108,7 @@ TEST_P(SmallResendTest, ALateListenerGetsTheWholeRouteUnderTheCap) {
   handle_all();
   request_resend(bus_, "test", {channels::kCloudPreview});
   handle_all();
+  mapper_->flush();  // a thinning pass still under way (live, on a thread of its own) done
   mapper_->publish_preview();
   handle_all();
   const auto live = preview_points(preview), again = preview_points(preview_again);

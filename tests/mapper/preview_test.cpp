@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <random>
 
 #include "mapper.hpp"
 #include "preview_resend.hpp"
@@ -126,6 +128,7 @@ int64_t drive_corridor(double from_m, double to_m, PreviewResend& resend,
         max_bytes_seen[0] = std::max(max_bytes_seen[0], resend.bytes());
       }
     }
+    resend.poll();  // as the node does before each group (nothing without the background mode)
   }
   return sent;
 }
@@ -174,6 +177,40 @@ TEST(PreviewResend, StaysUnderItsCapAndCoversTheWholeRoute) {
   for (int m = 0; m < 200; ++m) EXPECT_GT(per_metre[m], 0) << "no point between " << m << " m";
 }
 
+// Live, the passes run on a thread of their own while the route goes on: what arrives meanwhile is
+// kept apart and merged after the thinned store, so the answer still covers the whole route from
+// its first profile, in time order, and once the passes are done the store is under its cap.
+TEST(PreviewResend, InTheBackgroundKeepsTheWholeRouteToo) {
+  constexpr int64_t kCap = 256 << 10;
+  PreviewResend resend(0.05, kCap, true);
+  int64_t max_bytes[1] = {0};
+  const int64_t sent = drive_corridor(0.0, 200.0, resend, max_bytes);
+  resend.wait();
+  EXPECT_FALSE(resend.thinning());
+  EXPECT_GT(resend.counters().compactions, 0);
+  EXPECT_LE(resend.bytes(), kCap);
+  EXPECT_EQ(resend.counters().points_compacted, sent - resend.points());
+  EXPECT_GT(resend.cell_m(), 0.05);
+  resend.restart();
+  std::vector<int> per_metre(201, 0);
+  int64_t answered = 0, last_utime = 0;
+  bool first_profile = false;
+  while (resend.resending()) {
+    for (const PreviewProfile& p : resend.next(9000)) {
+      EXPECT_GE(p.utime, last_utime);  // in time order, what came during a pass after the rest
+      last_utime = p.utime;
+      first_profile |= p.utime == kT0;
+      answered += static_cast<int64_t>(p.p_base_mm.size());
+      for (const auto& q : p.p_base_mm) {
+        ++per_metre[std::clamp(static_cast<int>(p.T_world_base.x() + q[0] * 1e-3), 0, 200)];
+      }
+    }
+  }
+  EXPECT_EQ(answered, resend.points());
+  EXPECT_TRUE(first_profile);
+  for (int m = 0; m < 200; ++m) EXPECT_GT(per_metre[m], 0) << "no point between " << m << " m";
+}
+
 // The answer is paced out over seconds while the route goes on: a thinning pass meanwhile leaves
 // it going on in time order, under the cap, to the end.
 TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
@@ -198,6 +235,67 @@ TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
     }
   }
   EXPECT_GT(answered, 0u);
+}
+
+// A thinning pass coarsens the cells from their indices: the same cell as preview_cell() at twice
+// the edge, for points on both sides of the origin and on cell boundaries.
+TEST(PreviewCell, DoubledFromItsIndicesIsTheCellAtTwiceTheEdge) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coordinate(-900.0, 900.0);
+  for (double cell_m : {0.05, 0.1, 0.2, 0.35, 1.6, 12.8}) {
+    for (int i = 0; i < 20000; ++i) {
+      double x = coordinate(rng), y = coordinate(rng), z = coordinate(rng) / 100.0;
+      if (i % 4 == 0) x = cell_m * std::round(x / cell_m);  // on a boundary
+      const auto fine = preview_cell(x, y, z, cell_m);
+      const auto coarse = preview_cell(x, y, z, 2.0 * cell_m);
+      ASSERT_TRUE(fine && coarse);
+      ASSERT_EQ(preview_cell_doubled(*fine), *coarse) << x << " " << y << " " << z << " " << cell_m;
+    }
+  }
+}
+
+// Right after each thinning pass the store holds, for every cell of its grid that any point sent
+// fell in, exactly the earliest of them.
+TEST(PreviewResend, AfterAPassEachCellHoldsItsEarliestPoint) {
+  PreviewResend resend(0.05, 16 << 10);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> horizontal(-3000, 3000), vertical(0, 2500);  // [mm]
+  std::vector<PreviewProfile> sent;
+  using Point = std::pair<int64_t, std::array<int16_t, 3>>;  // utime [us], base frame [mm]
+  int passes_checked = 0;
+  for (int i = 0; i < 400; ++i) {
+    // Poses exact in float (as the store keeps them) and no turn: cells computed here as there.
+    PreviewProfile p{kT0 + i * 33'333, {}, Pose2(0.25 * (i % 40), 0.0, 0.0)};
+    for (int j = 0; j < 60; ++j) {
+      p.p_base_mm.push_back({static_cast<int16_t>(horizontal(rng)),
+                             static_cast<int16_t>(horizontal(rng)),
+                             static_cast<int16_t>(vertical(rng))});
+    }
+    const int64_t passes = resend.counters().compactions;
+    resend.add(p);
+    sent.push_back(p);
+    if (resend.counters().compactions == passes) continue;
+    ++passes_checked;
+    const auto cell_of = [&](const PreviewProfile& profile, const std::array<int16_t, 3>& q) {
+      return preview_cell(profile.T_world_base.x() + q[0] * 1e-3, q[1] * 1e-3, q[2] * 1e-3,
+                          resend.cell_m());
+    };
+    std::map<uint64_t, Point> earliest, kept;
+    for (const PreviewProfile& s : sent) {
+      for (const auto& q : s.p_base_mm) earliest.try_emplace(cell_of(s, q).value(), s.utime, q);
+    }
+    resend.restart();
+    while (resend.resending()) {
+      for (const PreviewProfile& k : resend.next(1000)) {
+        for (const auto& q : k.p_base_mm) {
+          EXPECT_TRUE(kept.try_emplace(cell_of(k, q).value(), k.utime, q).second);
+        }
+      }
+    }
+    EXPECT_EQ(kept, earliest) << "after pass " << resend.counters().compactions;
+  }
+  EXPECT_GE(passes_checked, 3);
+  EXPECT_GT(resend.cell_m(), 0.2);
 }
 
 }  // namespace
