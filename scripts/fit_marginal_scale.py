@@ -16,7 +16,8 @@ traverse-annotator-eval does) and its published covariance, split into the graph
 two terms; the fit is the marginal_scale at which 95 % of the pooled key poses' NEES lie inside
 the chi-square 95 % quantile of two degrees of freedom (5.991), with the two terms as they are.
 Printed per run and pooled: the NEES q95 as published, the share inside the 95 % ellipse, the
-scale that run alone would need (0: the two terms alone already hold 95 % of it). The defaults of
+scale that run alone would need (0: the two terms alone already hold 95 % of it), and the rms
+turn about the first key pose its errors amount to beside the frame's sigma (median). The defaults of
 the options are configs/backend.yaml's: the logs must have been made with it. JSON last.
 """
 import argparse
@@ -102,6 +103,14 @@ def nees(rows, scale, pose_sigma):
     return quad / det
 
 
+def turn_rms(rows, min_distance_m=5.0):
+    """[rad] The part of each error across the line from the first key pose over its distance, rms
+    over the key poses beyond min_distance_m: what a turn of the frame about the first key pose
+    would explain (to hold against the frame's sigma), slips along the path adding to it too."""
+    turns = [float(e @ J) / float(J @ J) for e, J, _, _ in rows if J @ J > min_distance_m ** 2]
+    return float(np.sqrt(np.mean(np.square(turns)))) if turns else 0.0
+
+
 def fit_scale(rows, pose_sigma, lo=1e-3, hi=1e6):
     """The scale at which the NEES q95 is 5.991 (it falls as the scale grows): 0 when the two
     terms alone bring it under, hi when no scale up to hi does."""
@@ -145,21 +154,24 @@ def main():
         name = os.path.basename(os.path.dirname(os.path.abspath(path))) or path
         runs[name] = {"key_poses": len(rows), "nees_q95": float(np.quantile(n, 0.95)),
                       "inside_95": float(np.mean(n <= CHI2_2_95)),
-                      "own_marginal_scale": fit_scale(rows, args.key_pose_sigma)}
+                      "own_marginal_scale": fit_scale(rows, args.key_pose_sigma),
+                      "turn_rms_rad": turn_rms(rows),
+                      "frame_sigma_median_rad": float(np.median([r[3] for r in rows]))}
         rows_of[name] = rows
         pooled += rows
     scale = fit_scale(pooled, args.key_pose_sigma)
     print(f"published with marginal_scale {args.published_scale:g}, key pose sigma "
           f"{args.key_pose_sigma:g} m, frame heading sigma {args.frame_heading_sigma:g} rad "
           "before the boresight holds")
-    print(f"{'run':64} {'key poses':>9} {'NEES q95':>8} {'inside':>6} {'own scale':>9}  "
-          "at the fitted scale: NEES q95, inside")
+    print(f"{'run':64} {'key poses':>9} {'NEES q95':>8} {'inside':>6} {'own scale':>9} "
+          f"{'turn rms [mrad]':>15} {'frame sigma [mrad]':>18}  at the fitted scale: NEES q95, inside")
     for name, r in runs.items():
         rows_n = nees(rows_of[name], scale, args.key_pose_sigma)
         r["fitted_nees_q95"] = float(np.quantile(rows_n, 0.95))
         r["fitted_inside_95"] = float(np.mean(rows_n <= CHI2_2_95))
         print(f"{name:64} {r['key_poses']:9d} {r['nees_q95']:8.2f} {r['inside_95']:6.3f} "
-              f"{r['own_marginal_scale']:9.1f}  {r['fitted_nees_q95']:.2f}, "
+              f"{r['own_marginal_scale']:9.1f} {1e3 * r['turn_rms_rad']:15.2f} "
+              f"{1e3 * r['frame_sigma_median_rad']:18.2f}  {r['fitted_nees_q95']:.2f}, "
               f"{r['fitted_inside_95']:.3f}")
     print(f"marginal_scale fitted on {len(runs)} runs ({len(pooled)} key poses): {scale:.4g}")
     print(json.dumps({"marginal_scale": scale, "published_scale": args.published_scale,
