@@ -9,7 +9,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PACKAGES=(build-essential cmake pkg-config liblcm-dev liblcm-bin libeigen3-dev libsuitesparse-dev
   liboctomap-dev octomap-tools libyaml-cpp-dev libcli11-dev libspdlog-dev libgtest-dev
-  libbenchmark-dev libceres-dev zlib1g-dev nlohmann-json3-dev python3 python3-matplotlib python3-yaml iproute2
+  libbenchmark-dev libceres-dev zlib1g-dev nlohmann-json3-dev python3 python3-matplotlib python3-numpy python3-yaml iproute2
   liblcm-java libjchart2d-java default-jdk-headless libboost-dev chromium)
 command -v npm >/dev/null 2>&1 || PACKAGES+=(nodejs npm)
 

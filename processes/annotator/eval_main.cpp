@@ -10,8 +10,9 @@
 // KEY_POSES and POSE_GRAPH_EDGES, on an in-process bus, and evaluates its annotations instead of
 // the recorded ones: a new calibration is evaluated without running the graph again.
 // --compact OUT writes a small log holding only what this evaluation reads (the backend's and the
-// annotator's channels, the ground truth and the scans of the key poses), so a run's large log
-// need not be kept.
+// annotator's channels, the ground truth and the scans of the key poses) and the backend's status
+// (scripts/fit_marginal_scale.py reads the boresight's sigma from it), so a run's large log need
+// not be kept.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -52,7 +53,8 @@ std::string num(double v) {
 
 struct Options {
   std::string log, csv, key_poses = "KEY_POSES", annotations = "ANNOTATIONS",
-                        truth = "POSE_GROUND_TRUTH", scans = "SCAN_HORIZONTAL";
+                        truth = "POSE_GROUND_TRUTH", scans = "SCAN_HORIZONTAL",
+                        backend_status = "STATUS_BACKEND";
   std::string recompute, compact, edges = "POSE_GRAPH_EDGES";
   bool compact_graph_only = false;
   int points_every = 10;
@@ -73,6 +75,9 @@ int main(int argc, char** argv) {
   app.add_option("--recompute", o.recompute,
                  "annotator config: recompute the annotations from the log's backend messages");
   app.add_option("--compact", o.compact, "write the events this evaluation reads into this log");
+  app.add_option("--backend-status", o.backend_status,
+                 "process_status_t channel --compact keeps (the boresight's sigma, which "
+                 "scripts/fit_marginal_scale.py reads)");
   app.add_flag("--compact-graph-only", o.compact_graph_only,
                "--compact keeps only the backend's and the annotator's channels");
   app.add_option("--points-every", o.points_every, "use every Nth beam of a key pose's scan")
@@ -151,7 +156,7 @@ int main(int argc, char** argv) {
     while (auto e = reader.next()) {
       ++events;
       const bool backend = e->channel == o.key_poses || e->channel == o.edges;
-      if (backend || e->channel == o.annotations) keep(*e);
+      if (backend || e->channel == o.annotations || e->channel == o.backend_status) keep(*e);
       if (e->channel == o.truth && !o.compact_graph_only) keep(*e);
       if (node && backend) {
         bus->lcm().publish(e->channel, e->data.data(), static_cast<unsigned>(e->data.size()));
