@@ -28,11 +28,11 @@
 #include "coverage.hpp"
 #include "json.hpp"
 #include "lcm_log.hpp"
-#include "version.hpp"
 #include "traverse/annotations_t.hpp"
 #include "traverse/key_poses_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
+#include "version.hpp"
 
 namespace {
 
