@@ -63,6 +63,10 @@ void ResendAnswerer::on_request(const uint8_t* data, int size) {
     last->second = m.seq;
   }
   ++counters_.requests;
+  if (pacing_.answering && pacing_.answering(m.requester)) {
+    ++counters_.paced;
+    return;
+  }
   const bool paced = pacing_.min_us > 0 && pacing_.data_time;
   const int64_t now = paced ? pacing_.data_time() : 0;
   const auto key = [&](const std::string& channel) {

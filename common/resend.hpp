@@ -15,9 +15,11 @@
 //
 // Answers are paced by data time (ResendPacing): an answer is a channel's whole state, and every
 // process on the multicast bus receives it, so a requester that asks in a loop must not make the
-// producer send it again and again. At most one answer per channel per kResendMinDataS of the
-// producer's data time (so a replay answers as the live run did), per channel or per requester
-// (ResendPacing::Scope); a request inside that stretch is counted and dropped.
+// producer send it again and again. At most one answer per channel per `resend.pace_s` of the
+// producer's data time (its config's, resend_config.hpp; so a replay answers as the live run did),
+// per channel or per requester (ResendPacing::Scope); a request inside that stretch, or one from a
+// requester whose answer is still going out (the mapper's goes out over seconds), is counted and
+// dropped.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +29,7 @@
 #include <vector>
 
 #include "bus.hpp"
+#include "resend_config.hpp"
 
 namespace traverse {
 
@@ -44,13 +47,10 @@ struct ResendRequest {
   std::vector<std::string> named;  // the answerer's channels that it names, in its order
 };
 
-// [s] of a producer's data time between two answers on one channel (the backend's is its config's
-// graph_resend_min_s, 5 s by default).
-inline constexpr double kResendMinDataS = 5.0;
-
 struct ResendPacing {
-  // [us] of data time between two answers; 0 (or no data_time): every request answered
-  int64_t min_us = static_cast<int64_t>(kResendMinDataS * 1e6);
+  // [us] of data time between two answers (ResendConfig::pace_us()); 0 (or no data_time): no
+  // stretch, every request answered but for `answering` below
+  int64_t min_us = ResendConfig{}.pace_us();
   std::function<int64_t()> data_time;  // [us] the producer's newest data time
   // Whose answer starts the stretch. kChannel: any requester's; the one answer goes to every
   // listener (the backend: its listener asks again whenever something is still missing).
@@ -58,6 +58,11 @@ struct ResendPacing {
   // have been listening when the last answer went (the densifier and the annotator: their
   // listeners, the viewer and the mapper, ask once, when they start).
   enum class Scope { kChannel, kRequester } scope = Scope::kRequester;
+  // For an answer that goes out over time (the mapper's, paced by bytes: seconds for a whole
+  // store): true while an answer that `requester` will get whole is still going out. Its request
+  // is then paced whatever the data time: answered, it would restart what the requester is being
+  // sent. Empty: every answer goes out at once.
+  std::function<bool(const std::string& requester)> answering = nullptr;
 };
 
 // Answers the requests that name any of `channels` (empty names: channels not published, never
@@ -76,7 +81,7 @@ class ResendAnswerer {
   struct Counters {
     int64_t requests = 0;  // well-formed, new, naming one of the channels
     int64_t answers = 0;   // of those, answered
-    int64_t paced = 0;     // of those, every channel named inside its stretch: dropped
+    int64_t paced = 0;     // of those, inside its stretch (or its answer going out): dropped
     int64_t repeated = 0;  // not newer than the last from the same requester: dropped
     int64_t rejected = 0;  // did not decode: dropped
   };

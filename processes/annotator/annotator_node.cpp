@@ -27,6 +27,7 @@ std::optional<std::string> validate(const AnnotatorNodeConfig& c) {
   check.not_empty("annotations_channel", c.annotations_channel);
   // 52 bytes per key pose: at most 1200 keep a part under 64 KB.
   check.in_range("max_keys_per_message", c.max_keys_per_message, 1, 1200);
+  check.nested("resend", validate(c.resend));
   if (check.problem()) return check.problem();
   return validate(c.annotator);  // its keys sit at the top level of the file
 }
@@ -106,8 +107,8 @@ AnnotatorNode::AnnotatorNode(Bus& bus, const AnnotatorNodeConfig& config, Counte
         return true;
       },
       // Its listeners (the mapper, the viewer) ask once, at start: each requester is answered,
-      // at most once per kResendMinDataS of key pose time.
-      ResendPacing{.data_time = [this] { return utime_; }});
+      // at most once per resend.pace_s of key pose time.
+      ResendPacing{.min_us = config_.resend.pace_us(), .data_time = [this] { return utime_; }});
   if (!config_.ask_for_state) return;
   // The backend's answers: the whole graph, read like an update.
   bus_.subscribe<pose_graph_edges_t>(

@@ -37,7 +37,10 @@ struct AnnotatorNodeConfig {
   std::string annotations_channel = channels::kAnnotations;
   bool ask_for_state = true;        // ask the backend for its whole graph when something is missing
   int max_keys_per_message = 1000;  // 52 bytes each: a part stays under 64 KB
-  AnnotatorConfig annotator;        // its keys sit at the top level of the file
+  // resend.pace_s: a late listener (the mapper, the viewer) is answered at most once per this
+  // much key pose time (common/resend.hpp)
+  ResendConfig resend;
+  AnnotatorConfig annotator;  // its keys sit at the top level of the file
 
   template <class V>
   void visit(V& v) {
@@ -46,6 +49,7 @@ struct AnnotatorNodeConfig {
     v("annotations_channel", annotations_channel);
     v("ask_for_state", ask_for_state);
     v("max_keys_per_message", max_keys_per_message);
+    v("resend", resend);
     annotator.visit(v);
   }
 };

@@ -27,7 +27,7 @@ std::optional<std::string> validate(const BackendNodeConfig& c) {
   check.not_empty("key_poses_channel", c.key_poses_channel);
   check.not_empty("trajectory_channel", c.trajectory_channel);
   check.not_empty("edges_channel", c.edges_channel);
-  check.in_range("graph_resend_min_s", c.graph_resend_min_s, 0.0, 3600.0);
+  check.nested("resend", validate(c.resend));
   check.in_range("max_poses_per_message", c.max_poses_per_message, 1, 580);
   check.not_negative("publish_move_m", c.publish_move_m);
   check.not_negative("publish_turn_rad", c.publish_turn_rad);
@@ -52,9 +52,9 @@ BackendNode::BackendNode(Bus& bus, const BackendNodeConfig& config, CounterSink 
                                [this](const odometry_t& m) { on_odometry(m); });
   }
   // The answer goes to every listener, and one that still lacks something asks again after the
-  // next optimisation: one answer per channel per graph_resend_min_s serves all who asked.
+  // next optimisation: one answer per channel per resend.pace_s serves all who asked.
   ResendPacing pacing{
-      std::llround(config_.graph_resend_min_s * 1e6),
+      config_.resend.pace_us(),
       [this] {
         return published_.empty() ? int64_t{0} : backend_.key_poses()[published_.size() - 1].utime;
       },

@@ -11,7 +11,7 @@
 // with every edge on POSE_GRAPH_EDGES_FULL and every key pose on KEY_POSES_FULL (same types and
 // parts as the incremental channels, no loop closures listed): separate channels, so that
 // listeners that only follow updates (the densifier, which would re-send every segment) never see
-// the repeat. At most one answer per channel per graph_resend_min_s of data time (the newest key
+// the repeat. At most one answer per channel per resend.pace_s of data time (the newest key
 // pose's time, so a replay answers the same way as the live run): a request inside that stretch
 // is dropped, the answer having gone to every listener; one that still lacks something asks again
 // after the next optimisation.
@@ -42,8 +42,7 @@ struct BackendNodeConfig {
   std::string key_poses_channel = channels::kKeyPoses;
   std::string trajectory_channel = channels::kPoseBackend;
   std::string edges_channel = channels::kPoseGraphEdges;
-  // [s] of data time between two answers on a _FULL channel (common/resend.hpp)
-  double graph_resend_min_s = kResendMinDataS;
+  ResendConfig resend;  // resend.pace_s: data time between two answers on a _FULL channel
   int max_poses_per_message = 400;          // 112 bytes each: 400 keep a part under 64 KB
   double publish_move_m = 0.001;            // a key pose moved farther than this is republished [m]
   double publish_turn_rad = 0.0005;         // ... or turned more than this [rad]
@@ -64,7 +63,7 @@ struct BackendNodeConfig {
     v("key_poses_channel", key_poses_channel);
     v("trajectory_channel", trajectory_channel);
     v("edges_channel", edges_channel);
-    v("graph_resend_min_s", graph_resend_min_s);
+    v("resend", resend);
     v("max_poses_per_message", max_poses_per_message);
     v("publish_move_m", publish_move_m);
     v("publish_turn_rad", publish_turn_rad);

@@ -24,6 +24,7 @@ std::optional<std::string> validate(const DensifierConfig& c) {
   check.not_negative("spike_threshold_m", c.spike_threshold_m);
   check.not_negative("spike_max_span_us", c.spike_max_span_us);
   check.not_negative("spike_min_interval_us", c.spike_min_interval_us);
+  check.nested("resend", validate(c.resend));
   return check.problem();
 }
 

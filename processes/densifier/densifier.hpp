@@ -57,6 +57,7 @@
 #include <string>
 #include <vector>
 
+#include "resend_config.hpp"
 #include "se2.hpp"
 
 namespace traverse::densifier {
@@ -79,6 +80,9 @@ struct DensifierConfig {
   // [us] ... and each at least this far from it: stamps squeezed closer (a log whose clock
   // failed) need not be in the order of the motion, and a real pose looks like a spike
   int64_t spike_min_interval_us = 5000;
+  // resend.pace_s: a late listener (the viewer) is answered at most once per this much frontend
+  // time (densifier_node.hpp, common/resend.hpp)
+  ResendConfig resend;
   template <class V>
   void visit(V& v) {
     v("mode", mode);
@@ -91,6 +95,7 @@ struct DensifierConfig {
     v("spike_threshold_m", spike_threshold_m);
     v("spike_max_span_us", spike_max_span_us);
     v("spike_min_interval_us", spike_min_interval_us);
+    v("resend", resend);
   }
 };
 

@@ -61,14 +61,15 @@ DensifierNode::DensifierNode(Bus& bus, const DensifierConfig& config, CounterSin
   bus_.subscribe<key_poses_t>(
       config_.key_pose_channel, [this](const key_poses_t& m) { on_key_poses(m); }, true);
   // Its listener (the viewer) asks once, at start: each requester is answered, at most once per
-  // kResendMinDataS of frontend time.
+  // resend.pace_s of frontend time.
   resend_ = std::make_unique<ResendAnswerer>(
       bus_, std::vector<std::string>{channels::kDenseSegments},
       [this](const ResendRequest&) {
         publish(densifier_.sent_segments(), channels::full_channel(channels::kDenseSegments));
         return true;
       },
-      ResendPacing{.data_time = [this] { return newest_frontend_utime_; }});
+      ResendPacing{.min_us = config_.resend.pace_us(),
+                   .data_time = [this] { return newest_frontend_utime_; }});
 }
 
 void DensifierNode::on_frontend(const pose2d_t& msg) {

@@ -33,6 +33,7 @@ std::optional<std::string> validate(const MapperConfig& c) {
   check.positive("max_pending_s", c.max_pending_s);
   check.in_range("move_threads", c.move_threads, 1, 64);
   check.nested("preview", validate(c.preview));
+  check.nested("resend", validate(c.resend));
   return check.problem();
 }
 

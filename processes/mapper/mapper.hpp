@@ -36,6 +36,7 @@
 #include "planar_scan.hpp"
 #include "point_colours.hpp"
 #include "preview.hpp"
+#include "resend_config.hpp"
 #include "trajectory_store.hpp"
 
 namespace traverse::mapper {
@@ -69,6 +70,9 @@ struct MapperConfig {
   double max_pending_s = 30.0;  // [s] profiles waiting longer for poses are dropped
   int move_threads = 2;         // threads that place moved profiles again (counts: one thread)
   PreviewConfig preview;        // decimated points for screens on CLOUD_PREVIEW (preview.hpp)
+  // resend.pace_s: a late viewer is sent the preview again at most once per this much profile
+  // time (mapper_node.hpp, common/resend.hpp)
+  ResendConfig resend;
   template <class V>
   void visit(V& v) {
     v("resolution_m", resolution_m);
@@ -83,6 +87,7 @@ struct MapperConfig {
     v("max_pending_s", max_pending_s);
     v("move_threads", move_threads);
     v("preview", preview);
+    v("resend", resend);
   }
 };
 

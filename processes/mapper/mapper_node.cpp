@@ -48,11 +48,22 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
     // Live, a thinning pass runs on a thread of its own: this thread handles the messages.
     resend_store_ = std::make_unique<PreviewResend>(
         config_.preview.cell_m, config_.preview.resend_max_bytes, worker_thread);
+    const auto answering = [this](const std::string& requester) {
+      return resend_store_->resending() && answering_.count(requester) > 0;
+    };
     resend_ = std::make_unique<ResendAnswerer>(
-        bus, std::vector<std::string>{config_.preview.channel}, [this](const ResendRequest&) {
-          resend_store_->restart();  // from the start, paced by publish_preview()
+        bus, std::vector<std::string>{config_.preview.channel},
+        [this](const ResendRequest& r) {
+          // From the start, paced by publish_preview(): whoever the answer under way was going
+          // to has had its start, and now gets the whole again.
+          if (!resend_store_->resending()) answering_.clear();
+          answering_.insert(r.requester);
+          resend_store_->restart();
           return true;
-        });
+        },
+        ResendPacing{.min_us = config_.resend.pace_us(),
+                     .data_time = [this] { return newest_profile_utime_; },
+                     .answering = answering});
   }
   if (worker_thread) worker_ = std::thread([this] { run_worker(); });
 }
@@ -96,6 +107,7 @@ bool MapperNode::take_revision(int64_t key_id_first, int32_t revision) {
 }
 
 void MapperNode::on_profile(const planar_scan_t& msg) {
+  newest_profile_utime_ = std::max(newest_profile_utime_, msg.utime);
   Profile p{to_planar_scan(msg), {}};
   if (msg.n_intensities8 == msg.n_ranges) {
     p.intensities = msg.intensities8;

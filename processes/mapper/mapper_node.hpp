@@ -14,12 +14,16 @@
 // Late listeners (common/resend.hpp): a viewer that starts after the mapper asks for the preview
 // (resend_request_t naming CLOUD_PREVIEW) and gets it again on CLOUD_PREVIEW_FULL, paced by
 // publish_preview() (640 KB/s) so as not to overflow the sockets of the viewer or of the other
-// processes, which receive every multicast message. What is kept for that is capped
-// (preview.resend_max_bytes) and thinned to a coarser grid beyond the cap (preview_resend.hpp), so
-// it follows the map, not the run; live, a thinning pass runs on a thread of its own, so this
-// thread's message handling never waits for it. In turn the node asks the annotator for every
-// annotation when it starts (ANNOTATIONS_FULL), so a mapper started after the annotator colours its
-// points at once, not grey until the end of data.
+// processes, which receive every multicast message. Requests are paced per requester like the
+// densifier's (ResendPacing): at most one answer per resend.pace_s of profile time, a requester
+// not answered yet at once (the answer starts again from the oldest profile, and every requester
+// of the answer under way gets it whole), and a request from a requester whose answer is still
+// going out (a whole store takes seconds) is dropped, not restarted. What is kept for that is
+// capped (preview.resend_max_bytes) and thinned to a coarser grid beyond the cap
+// (preview_resend.hpp), so it follows the map, not the run; live, a thinning pass runs on a thread
+// of its own, so this thread's message handling never waits for it. In turn the node asks the
+// annotator for every annotation when it starts (ANNOTATIONS_FULL), so a mapper started after the
+// annotator colours its points at once, not grey until the end of data.
 //
 // Live, the Mapper runs on a worker thread and the message handlers only queue what arrives:
 // after a loop closure the mapper re-places thousands of profiles (several seconds of work on a
@@ -45,6 +49,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <variant>
@@ -133,6 +138,8 @@ class MapperNode {
   // the current pacing window.
   std::unique_ptr<PreviewResend> resend_store_;
   std::unique_ptr<ResendAnswerer> resend_;
+  std::set<std::string> answering_;   // the requesters the answer under way goes to whole
+  int64_t newest_profile_utime_ = 0;  // [us] the data time answers are paced by
   std::chrono::steady_clock::time_point resend_window_;
   std::size_t resend_window_bytes_ = 0;
   double resend_messages_ = 0;

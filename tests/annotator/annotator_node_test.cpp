@@ -101,8 +101,9 @@ TEST_F(AnnotatorNodeTest, ALateListenerGetsEveryAnnotation) {
 }
 
 // Requests are paced by key pose time (common/resend.hpp): a burst from one requester gets one
-// answer per kResendMinDataS (5 s), and a requester not answered yet is answered inside that
-// stretch. The data time is the newest ANNOTATIONS message's (the annotator's newest key pose).
+// answer per resend.pace_s (5 s by default), and a requester not answered yet is answered inside
+// that stretch. The data time is the newest ANNOTATIONS message's (the annotator's newest key
+// pose).
 TEST_F(AnnotatorNodeTest, ABurstGetsOneAnswerPerStretchAndANewRequesterIsAnswered) {
   const auto answers = [this] {
     return std::count_if(full_.begin(), full_.end(),

@@ -105,7 +105,7 @@ TEST(AnnotatorLateJoin, AsksForTheGraphAndEndsWithTheSameBounds) {
 TEST(AnnotatorLateJoin, TwoListenersAskingAtOnceGetOneAnswer) {
   const Result r = run(0.5, true, true);
   EXPECT_EQ(r.backend_counters.at("resend_requests"), 2.0);
-  EXPECT_EQ(r.backend_counters.at("resend_answers"), 1.0);  // graph_resend_min_s apart at most
+  EXPECT_EQ(r.backend_counters.at("resend_answers"), 1.0);  // resend.pace_s apart at most
   ASSERT_EQ(r.second_late.size(), r.key_poses);
   for (const auto& [id, a] : r.second_late) {
     EXPECT_NEAR(a.local_bound_m, r.late.at(id).local_bound_m, 1e-12) << id;

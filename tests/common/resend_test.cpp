@@ -8,6 +8,7 @@
 
 #include <map>
 #include <memory>
+#include <string>
 
 #include "channels.hpp"
 #include "traverse/resend_request_t.hpp"
@@ -157,6 +158,58 @@ TEST(LateJoinResend, PacesAnswersByDataTimePerRequesterOrPerChannel) {
   EXPECT_EQ(per_requester->counters().paced, 2);
   EXPECT_EQ(per_channel->counters().paced, 3);
   EXPECT_EQ(per_channel->counters().answers, 2);
+}
+
+// An answer that goes out over time (the mapper's): a request from a requester it still goes to
+// is paced, past its stretch too, and with no stretch at all; another requester is answered, and
+// once the answer is out the first one is too.
+TEST(LateJoinResend, ARequestWhileItsAnswerGoesOutIsPaced) {
+  for (const int64_t min_us : {int64_t{1'000'000}, int64_t{0}}) {
+    Bus bus("memq://");
+    int64_t now = 0;       // [us] the producer's data time
+    std::string going_to;  // the requester of the answer going out ("": none)
+    int answers = 0;
+    ResendAnswerer answerer(
+        bus, {"PREVIEW"},
+        [&](const ResendRequest& r) {
+          going_to = r.requester;
+          return ++answers > 0;
+        },
+        ResendPacing{.min_us = min_us,
+                     .data_time = [&] { return now; },
+                     .answering = [&](const std::string& who) { return who == going_to; }});
+    const auto ask = [&](const std::string& who) {
+      request_resend(bus, who, {"PREVIEW"});
+      handle_all(bus);
+    };
+    ask("viewer");
+    now += 2'000'000;  // past its stretch, its answer still going out
+    ask("viewer");
+    EXPECT_EQ(answers, 1) << min_us;
+    ask("other");
+    EXPECT_EQ(answers, 2) << min_us;
+    going_to.clear();  // out
+    ask("viewer");
+    EXPECT_EQ(answers, 3) << min_us;
+    EXPECT_EQ(answerer.counters().requests, 4) << min_us;
+    EXPECT_EQ(answerer.counters().paced, 1) << min_us;
+  }
+}
+
+// resend.pace_s of every producer's config: seconds in, microseconds out, 0 to an hour.
+TEST(LateJoinResend, ThePaceIsAConfigKeyInSeconds) {
+  ResendConfig c;
+  EXPECT_EQ(c.pace_us(), 5'000'000);
+  EXPECT_EQ(ResendPacing{}.min_us, c.pace_us());
+  load_config_text("pace_s: 1.5\n", "resend.yaml", c);
+  EXPECT_EQ(c.pace_us(), 1'500'000);
+  EXPECT_FALSE(validate(c));
+  c.pace_s = 0.0;  // every request answered
+  EXPECT_FALSE(validate(c));
+  for (const double bad : {-0.5, 3600.5}) {
+    c.pace_s = bad;
+    EXPECT_NE(validate(c).value_or("").find("'pace_s'"), std::string::npos) << bad;
+  }
 }
 
 TEST(LateJoinResend, AProducerWithoutTheChannelAnswersNothing) {

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <memory>
+#include <string>
 
 #include "channels.hpp"
 
@@ -72,34 +74,34 @@ TEST(PackSegments, NothingToSendGivesNoMessage) {
   EXPECT_TRUE(pack_segments({}, "world", "base", 0, 60000).empty());
 }
 
-// A burst of requests from one requester gets one answer per kResendMinDataS (5 s) of frontend
-// time (common/resend.hpp); a requester not answered yet is answered inside that stretch.
-TEST(DensifierNodeResend, ABurstGetsOneAnswerPerStretchAndANewRequesterIsAnswered) {
-  Bus bus("memq://");
-  std::map<std::string, double> counters;
-  DensifierNode node(bus, DensifierConfig{},
-                     [&](const std::string& k, double v) { counters[k] = v; });
-  int answers = 0, answered_segments = 0;  // answers on DENSE_SEGMENTS_FULL, the first's segments
-  bus.subscribe<dense_segments_t>(
-      channels::full_channel(channels::kDenseSegments),
-      [&](const dense_segments_t& m) {
-        answers += m.part == 0;
-        if (answers == 1) answered_segments += m.n_segments;
-      },
-      true);
-  const auto handle_all = [&] {
-    while (bus.lcm().handleTimeout(0) > 0) {
+// A late listener's requests to a densifier node over memq://, with frontend poses at 10 Hz and a
+// key pose a second driven along x.
+class DensifierNodeResend : public ::testing::Test {
+ protected:
+  void start(const DensifierConfig& config) {
+    node_ = std::make_unique<DensifierNode>(
+        bus_, config, [this](const std::string& k, double v) { counters_[k] = v; });
+    bus_.subscribe<dense_segments_t>(
+        channels::full_channel(channels::kDenseSegments),
+        [this](const dense_segments_t& m) {
+          answers_ += m.part == 0;
+          if (answers_ == 1) answered_segments_ += m.n_segments;
+        },
+        true);
+  }
+  void handle_all() {
+    while (bus_.lcm().handleTimeout(0) > 0) {
     }
-  };
-  constexpr int64_t kDt = 100'000;  // [us] frontend poses at 10 Hz, a key pose a second
-  const auto drive = [&](int from, int to) {
+  }
+  void drive(int from, int to) {
+    constexpr int64_t kDt = 100'000;  // [us]
     for (int i = from; i < to; ++i) {
       pose2d_t p{};
       p.utime = i * kDt;
       p.parent_frame = "map";
       p.child_frame = "base";
       p.x = 0.05 * i;  // [m] 0.5 m/s along x
-      bus.publish(channels::kPoseFrontend, p);
+      bus_.publish(channels::kPoseFrontend, p);
       if (i % 10 == 0) {
         key_poses_t k{};
         k.utime = p.utime;
@@ -111,31 +113,66 @@ TEST(DensifierNodeResend, ABurstGetsOneAnswerPerStretchAndANewRequesterIsAnswere
         pose.x = p.x;
         k.poses.push_back(pose);
         k.n_poses = 1;
-        bus.publish(channels::kKeyPoses, k);
+        bus_.publish(channels::kKeyPoses, k);
       }
       handle_all();
     }
-  };
-  const auto ask = [&](const std::string& who) {
-    request_resend(bus, who, {channels::kDenseSegments});
+  }
+  void ask(const std::string& who) {
+    request_resend(bus_, who, {channels::kDenseSegments});
     handle_all();
-  };
+  }
+  double counter(const std::string& name) {
+    node_->report_counters();
+    return counters_.at(name);
+  }
+
+  Bus bus_{"memq://"};
+  std::map<std::string, double> counters_;
+  std::unique_ptr<DensifierNode> node_;
+  int answers_ = 0;            // answers on DENSE_SEGMENTS_FULL
+  int answered_segments_ = 0;  // ... the first one's segments
+};
+
+// A burst of requests from one requester gets one answer per resend.pace_s (5 s by default) of
+// frontend time (common/resend.hpp); a requester not answered yet is answered inside that stretch.
+TEST_F(DensifierNodeResend, ABurstGetsOneAnswerPerStretchAndANewRequesterIsAnswered) {
+  start(DensifierConfig{});
   drive(0, 60);  // 5.9 s of data, five segments closed
   for (int k = 0; k < 4; ++k) ask("viewer");
-  EXPECT_EQ(answers, 1);
-  EXPECT_GE(answered_segments, 4);
+  EXPECT_EQ(answers_, 1);
+  EXPECT_GE(answered_segments_, 4);
   ask("second-viewer");  // not answered yet: answered inside the first one's stretch
-  EXPECT_EQ(answers, 2);
+  EXPECT_EQ(answers_, 2);
   drive(60, 100);  // 4 s after the answer: still inside the stretch
   ask("viewer");
-  EXPECT_EQ(answers, 2);
+  EXPECT_EQ(answers_, 2);
   drive(100, 120);  // 6 s after
   ask("viewer");
-  EXPECT_EQ(answers, 3);
-  node.report_counters();
-  EXPECT_EQ(counters.at("resend_requests"), 7.0);
-  EXPECT_EQ(counters.at("resend_answers"), 3.0);
-  EXPECT_EQ(counters.at("resend_requests_paced"), 4.0);
+  EXPECT_EQ(answers_, 3);
+  EXPECT_EQ(counter("resend_requests"), 7.0);
+  EXPECT_EQ(counter("resend_answers"), 3.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 4.0);
+}
+
+// The stretch is the config's resend.pace_s: with 1 s, a request 0.5 s of frontend time after the
+// answer is dropped and one 1.5 s after is answered (the default would drop both).
+TEST_F(DensifierNodeResend, TheConfiguredPaceIsTheStretch) {
+  DensifierConfig config;
+  config.resend.pace_s = 1.0;
+  ASSERT_FALSE(validate(config));
+  start(config);
+  drive(0, 60);
+  ask("viewer");
+  drive(60, 65);
+  ask("viewer");
+  EXPECT_EQ(answers_, 1);
+  drive(65, 75);
+  ask("viewer");
+  EXPECT_EQ(answers_, 2);
+  EXPECT_EQ(counter("resend_requests_paced"), 1.0);
+  config.resend.pace_s = -1.0;
+  EXPECT_NE(validate(config).value_or("").find("'resend.pace_s'"), std::string::npos);
 }
 
 }  // namespace

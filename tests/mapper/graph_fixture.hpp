@@ -36,6 +36,7 @@ class GraphTest : public ::testing::TestWithParam<bool> {
                ("traverse_graph_test_" + std::to_string(::getpid()) + (GetParam() ? "_w" : "_i"));
     mc.output_dir = out_dir_.string();
     mc.preview.resend_max_bytes = resend_max_bytes_;
+    configure(mc);
     Eigen::Isometry3d T_base_laser = Eigen::Isometry3d::Identity();
     T_base_laser.linear() =
         Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -53,6 +54,8 @@ class GraphTest : public ::testing::TestWithParam<bool> {
     bus_.subscribe<pose2d_t>(
         channels::kPoseDense, [this](const pose2d_t& m) { dense_.push_back(m); }, true);
   }
+  // A test's own mapper settings.
+  virtual void configure(mapper::MapperConfig&) {}
   void handle_all() {
     while (bus_.lcm().handleTimeout(0) > 0) {
     }
@@ -78,9 +81,9 @@ class GraphTest : public ::testing::TestWithParam<bool> {
     bus_.publish(channels::kScanProfile, s);
   }
 
-  // Frontend poses 0..n_poses 1 cm north of the truth, key poses (the truth) every kKeyEvery.
-  void drive(int n_poses, bool profiles) {
-    for (int i = 0; i <= n_poses; ++i) {
+  // Frontend poses first..n_poses 1 cm north of the truth, key poses (the truth) every kKeyEvery.
+  void drive(int n_poses, bool profiles, int first = 0) {
+    for (int i = first; i <= n_poses; ++i) {
       pose2d_t p{};
       p.utime = kT0 + i * kPoseDt;
       p.parent_frame = "map";

@@ -1,11 +1,15 @@
 // A listener that starts after the densifier and the mapper (resend.hpp, docs/late-joining.md):
-// what each answers, and the mapper's answer under its cap (preview.resend_max_bytes).
+// what each answers, the mapper's answer under its cap (preview.resend_max_bytes), and how the
+// mapper paces its answers (resend.pace_s).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <map>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "graph_fixture.hpp"
@@ -137,6 +141,119 @@ TEST_P(SmallResendTest, ALateListenerGetsTheWholeRouteUnderTheCap) {
   EXPECT_EQ(again.begin()->first, live.begin()->first);
   EXPECT_GT(again.rbegin()->first, live.rbegin()->first - 1'000'000);
 }
+
+// The mapper paces its answer like the densifier and the annotator (resend.hpp: per requester, by
+// data time, here the newest profile's). Its answer goes out over several calls of publish_preview
+// (64 KB per 100 ms), so a request can come while it is still going out.
+class PreviewPacingTest : public GraphTest {
+ protected:
+  void SetUp() override {
+    GraphTest::SetUp();
+    bus_.subscribe<cloud_preview_t>(channels::kCloudPreview,
+                                    [this](const cloud_preview_t& m) { preview_.push_back(m); });
+    bus_.subscribe<cloud_preview_t>(channels::full_channel(channels::kCloudPreview),
+                                    [this](const cloud_preview_t& m) { again_.push_back(m); });
+  }
+  void ask(const std::string& who) {
+    request_resend(bus_, who, {channels::kCloudPreview});
+    handle_all();
+  }
+  void publish() {
+    mapper_->flush();
+    mapper_->publish_preview();
+    handle_all();
+  }
+  // Publishes until a call after the byte window (100 ms of wall time) sends nothing more: the
+  // answer is out, however slow the machine.
+  void finish_answer() {
+    for (int calls = 0; calls < 1000; ++calls) {
+      const std::size_t before = again_.size();
+      std::this_thread::sleep_for(std::chrono::milliseconds(110));
+      publish();
+      if (again_.size() == before) return;
+    }
+    FAIL() << "the answer never ended";
+  }
+  double counter(const std::string& name) {
+    mapper_->report_counters();
+    return mapper_counters_.at(name);
+  }
+  static int64_t points(const std::vector<cloud_preview_t>& messages) {
+    int64_t n = 0;
+    for (const auto& [t, pts] : preview_points(messages)) n += static_cast<int64_t>(pts.size());
+    return n;
+  }
+
+  std::vector<cloud_preview_t> preview_, again_;
+};
+
+// A burst from one requester gets one answer, a second requester is answered at once (the answer
+// starts again and goes whole to both), and a request from a requester whose answer is still going
+// out is dropped, even past its stretch, instead of restarting it; once the answer is out and the
+// stretch over, the same requester is answered again.
+class BurstPacingTest : public PreviewPacingTest {
+ protected:
+  void configure(mapper::MapperConfig& c) override {
+    c.preview.cell_m = 0.01;  // a store several times what one call of publish_preview sends
+    c.preview.max_points_per_message = 1000;
+  }
+};
+
+TEST_P(BurstPacingTest, ABurstGetsOneAnswerAndARequestWhileItGoesOutDoesNotRestartIt) {
+  drive(300, true);  // 6 s of data
+  publish();
+  for (int k = 0; k < 4; ++k) ask("viewer");
+  ask("second-viewer");  // not answered yet: answered at once
+  EXPECT_EQ(counter("resend_answers"), 2.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 3.0);
+  publish();
+  RecordProperty("first_call_points", std::to_string(points(again_)));
+  RecordProperty("live_points", std::to_string(points(preview_)));
+  ASSERT_GT(points(again_), 0);
+  ASSERT_LT(points(again_), points(preview_)) << "the answer went out at once: enlarge the store";
+  drive(600, true, 301);  // 6 s more: past the viewer's 5 s stretch
+  ask("viewer");          // its answer is still going out
+  EXPECT_EQ(counter("resend_answers"), 2.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 4.0);
+  finish_answer();
+  // Every point sent live, once: the answer was not restarted (it would repeat its start).
+  EXPECT_TRUE(preview_points(again_) == preview_points(preview_))
+      << points(again_) << " points answered, " << points(preview_) << " sent live";
+  ask("viewer");  // the answer out, 6 s after it began
+  EXPECT_EQ(counter("resend_requests"), 7.0);
+  EXPECT_EQ(counter("resend_answers"), 3.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 4.0);
+}
+
+// resend.pace_s of the mapper's config is the stretch: with 1 s, a request 0.5 s of data after
+// the answer is dropped, one 1.5 s after is answered (the default 5 s would drop it).
+class ConfiguredPacingTest : public PreviewPacingTest {
+ protected:
+  void configure(mapper::MapperConfig& c) override { c.resend.pace_s = 1.0; }
+};
+
+TEST_P(ConfiguredPacingTest, ARequestPastTheConfiguredStretchIsAnswered) {
+  drive(100, true);  // the newest profile at 1.92 s
+  publish();
+  ask("viewer");
+  finish_answer();
+  EXPECT_TRUE(preview_points(again_) == preview_points(preview_))
+      << points(again_) << " points answered, " << points(preview_) << " sent live";
+  drive(125, true, 101);  // newest profile at 2.46 s
+  ask("viewer");
+  EXPECT_EQ(counter("resend_answers"), 1.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 1.0);
+  drive(175, true, 126);  // newest profile at 3.42 s
+  ask("viewer");
+  EXPECT_EQ(counter("resend_answers"), 2.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 1.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Mapper, BurstPacingTest, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "worker" : "inline"; });
+
+INSTANTIATE_TEST_SUITE_P(Mapper, ConfiguredPacingTest, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "worker" : "inline"; });
 
 INSTANTIATE_TEST_SUITE_P(Mapper, SmallResendTest, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "worker" : "inline"; });
