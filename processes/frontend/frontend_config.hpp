@@ -22,6 +22,9 @@ struct MapConfig {
   double p_free = 0.4;             // probability a traversed cell is occupied (Hector 0.4)
   double update_distance_m = 0.2;  // update the map when the pose moved this far ...
   double update_angle_rad = 0.1;   // ... or turned this much since the last update
+  // Cells keep where in them the hits fell and the map is read there (occupancy_grid.hpp): walls
+  // a small angle off the grid's axes no longer pull the heading onto the axes.
+  bool subcell_hits = false;
   // Beyond this, tiles farthest from the pose are dropped: per map, so a sparse-scan ensemble
   // (MatcherConfig::sparse_ensemble_members) holds up to that many times this.
   int64_t max_bytes = 512LL << 20;
@@ -34,6 +37,7 @@ struct MapConfig {
     v("p_free", p_free);
     v("update_distance_m", update_distance_m);
     v("update_angle_rad", update_angle_rad);
+    v("subcell_hits", subcell_hits);
     v("max_bytes", max_bytes);
   }
 };

@@ -301,5 +301,42 @@ TEST(ScanMatcher, CovarianceAgreesWithScatterOfNoisyMatches) {
   }
 }
 
+// A corridor whose walls run a small angle off the map grid's axes: with each hit at its cell's
+// centre the walls are staircases and the match turns the scan towards the axis; with sub-cell
+// hits (MapConfig::subcell_hits) the heading holds. Scans of 8 m reach from poses every 0.2 m
+// along 30 m; each pose matched from itself, the worst heading error over the poses is taken.
+double worst_heading_error_off_axis(double wall_angle_rad, bool subcell) {
+  const Pose2 T_world_corridor(0.0, 0.0, wall_angle_rad);
+  synthetic::World world;
+  for (const auto& s : synthetic::office_block(40.0)) {
+    world.push_back({T_world_corridor * s.a, T_world_corridor * s.b});
+  }
+  std::vector<Pose2> poses;
+  for (double x = -15.0; x <= 15.0; x += 0.2)
+    poses.push_back(T_world_corridor * Pose2(x, 0.0, 0.0));
+  MapConfig config;
+  config.subcell_hits = subcell;
+  MapPyramid maps(config);
+  for (const auto& T : poses) {
+    maps.update(T, Eigen::Vector2d::Zero(), static_scan(world, T, 2880, 0.002, 7, 8.0));
+  }
+  double worst = 0.0;
+  unsigned seed = 11;
+  for (std::size_t k = 0; k < poses.size(); k += 5) {
+    const auto points = static_scan(world, poses[k], 1440, 0.002, ++seed, 8.0);
+    const MatchResult r = match_scan(maps, points, poses[k], MatcherConfig{});
+    worst = std::max(worst, std::abs(wrap_angle(r.T_map_base.theta() - poses[k].theta())));
+  }
+  return worst;
+}
+
+TEST(ScanMatcher, SubcellHitsKeepTheHeadingOfWallsOffTheGridsAxes) {
+  // The pull is the walls' angle itself, up to the angle at which the staircase steps every few
+  // metres (measured: 1.02 mrad at 1 mrad, 2.99 at 3, 0.68 at 20, 0.03 on the axes).
+  EXPECT_GT(worst_heading_error_off_axis(0.003, false), 0.002);
+  for (double angle : {0.0, 0.001, 0.003, 0.02}) {
+    EXPECT_LT(worst_heading_error_off_axis(angle, true), 0.0002) << "walls " << angle << " rad off";
+  }
+}
 }  // namespace
 }  // namespace traverse::frontend

@@ -6,7 +6,8 @@ namespace traverse::frontend {
 
 MapPyramid::MapPyramid(const MapConfig& config) {
   for (int k = 0; k < std::max(1, config.levels); ++k) {
-    grids_.emplace_back(config.resolution_m * std::ldexp(1.0, k), config.p_occupied, config.p_free);
+    grids_.emplace_back(config.resolution_m * std::ldexp(1.0, k), config.p_occupied, config.p_free,
+                        config.subcell_hits);
   }
 }
 

@@ -19,8 +19,9 @@ int64_t in_tile(int64_t i) { return i & (OccupancyGrid::kTileSize - 1); }
 
 }  // namespace
 
-OccupancyGrid::OccupancyGrid(double resolution_m, double p_occupied, double p_free)
+OccupancyGrid::OccupancyGrid(double resolution_m, double p_occupied, double p_free, bool subcell)
     : resolution_m_(resolution_m),
+      subcell_(subcell),
       occupied_delta_(log_odds_steps(p_occupied)),
       free_delta_(log_odds_steps(p_free)) {
   for (int l = -128; l < 128; ++l) {
@@ -51,7 +52,10 @@ OccupancyGrid::Tile& OccupancyGrid::tile_at(int64_t tx, int64_t ty) {
     journal_.emplace(key, slot ? std::make_unique<Tile>(*slot) : nullptr);
     if (slot) ++journal_saved_;
   }
-  if (!slot) slot = std::make_unique<Tile>();
+  if (!slot) {
+    slot = std::make_unique<Tile>();
+    if (subcell_) slot->subcell.resize(kTileCells);
+  }
   cached_key_ = key;
   cached_tile_ = slot.get();
   return *slot;
@@ -64,6 +68,78 @@ double OccupancyGrid::cell_probability(int64_t ix, int64_t iy) const {
 }
 
 double OccupancyGrid::value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const {
+  if (!subcell_) return interpolate(p_map, gradient);
+  Eigen::Matrix2d d_offset;
+  const Eigen::Vector2d offset = hit_offset(p_map, gradient ? &d_offset : nullptr);
+  const double m = interpolate(p_map - offset, gradient);
+  // Chain rule: d M(p - o(p)) / dp = (I - do/dp)^T grad M.
+  if (gradient) *gradient = (Eigen::Matrix2d::Identity() - d_offset).transpose() * *gradient;
+  return m;
+}
+
+Eigen::Vector2d OccupancyGrid::hit_offset(const Eigen::Vector2d& p_map,
+                                          Eigen::Matrix2d* jacobian) const {
+  if (jacobian) jacobian->setZero();
+  if (!subcell_) return Eigen::Vector2d::Zero();
+  const double gx = p_map.x() / resolution_m_, gy = p_map.y() / resolution_m_;
+  const double fx0 = std::floor(gx), fy0 = std::floor(gy);
+  const int64_t x0 = static_cast<int64_t>(fx0), y0 = static_cast<int64_t>(fy0);
+  const double fx = gx - fx0, fy = gy - fy0;
+  // Each of the four cells weighs by its bilinear weight times its occupied evidence (probability
+  // above 0.5): free and unknown cells say nothing about where a wall lies. The weighted sum of
+  // the offsets S and of the weights W, and their derivatives by fx and fy, give o = S / W.
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero(), dsum_dfx = sum, dsum_dfy = sum;
+  double weight = 0.0, dweight_dfx = 0.0, dweight_dfy = 0.0;
+  // All four cells in one tile (the usual case): one look-up.
+  const bool one_tile = in_tile(x0) < kTileSize - 1 && in_tile(y0) < kTileSize - 1;
+  const Tile* tile = one_tile ? find_tile(floor_div_tile(x0), floor_div_tile(y0)) : nullptr;
+  if (one_tile && !tile) return Eigen::Vector2d::Zero();
+  for (int dy = 0; dy <= 1; ++dy) {
+    for (int dx = 0; dx <= 1; ++dx) {
+      const int64_t ix = x0 + dx, iy = y0 + dy;
+      const Tile* t = one_tile ? tile : find_tile(floor_div_tile(ix), floor_div_tile(iy));
+      if (!t) continue;
+      const int64_t i = in_tile(iy) * kTileSize + in_tile(ix);
+      const double evidence = probability_of_[t->log_odds[i] + 128] - 0.5;
+      if (evidence <= 0.0 || t->subcell[i].count == 0) continue;
+      const double wx = dx ? fx : 1.0 - fx, wy = dy ? fy : 1.0 - fy;
+      const double dwx = dx ? 1.0 : -1.0, dwy = dy ? 1.0 : -1.0;
+      const Eigen::Vector2d o(t->subcell[i].x, t->subcell[i].y);
+      weight += wx * wy * evidence;
+      dweight_dfx += dwx * wy * evidence;
+      dweight_dfy += wx * dwy * evidence;
+      sum += wx * wy * evidence * o;
+      dsum_dfx += dwx * wy * evidence * o;
+      dsum_dfy += wx * dwy * evidence * o;
+    }
+  }
+  if (weight <= 0.0) return Eigen::Vector2d::Zero();
+  const double scale = resolution_m_ / kOffsetSteps;  // offset steps -> m
+  if (jacobian) {
+    // d(S/W)/df = (dS/df W - S dW/df) / W^2; f = p / resolution.
+    jacobian->col(0) =
+        (dsum_dfx * weight - sum * dweight_dfx) * (scale / (weight * weight * resolution_m_));
+    jacobian->col(1) =
+        (dsum_dfy * weight - sum * dweight_dfy) * (scale / (weight * weight * resolution_m_));
+  }
+  return sum * (scale / weight);
+}
+
+void OccupancyGrid::add_hit_offset(int64_t ix, int64_t iy, const Eigen::Vector2d& cell_offset) {
+  constexpr int kMaxCount = 32;  // the mean of about the last 32 hits
+  SubcellHits& h = tile_at(floor_div_tile(ix), floor_div_tile(iy))
+                       .subcell[in_tile(iy) * kTileSize + in_tile(ix)];
+  const int n = std::min<int>(h.count, kMaxCount - 1) + 1;
+  auto mean = [n](int16_t old, double offset_cells) {
+    const double x = old + (offset_cells * kOffsetSteps - old) / n;
+    return static_cast<int16_t>(std::clamp<long>(std::lround(x), -32767, 32767));
+  };
+  h.x = mean(h.x, cell_offset.x());
+  h.y = mean(h.y, cell_offset.y());
+  h.count = static_cast<uint8_t>(n);
+}
+
+double OccupancyGrid::interpolate(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const {
   const double gx = p_map.x() / resolution_m_, gy = p_map.y() / resolution_m_;
   const double fx0 = std::floor(gx), fy0 = std::floor(gy);
   const int64_t x0 = static_cast<int64_t>(fx0), y0 = static_cast<int64_t>(fy0);
@@ -144,6 +220,7 @@ void OccupancyGrid::update(const Eigen::Vector2d& origin_map,
   for (const auto& p : hits_map) {
     const auto [ix, iy] = cell(p);
     touch(ix, iy, occupied_delta_);
+    if (subcell_) add_hit_offset(ix, iy, p / resolution_m_ - Eigen::Vector2d(ix, iy));
   }
   // Free space along each beam up to a cell short of the hit, further short when it grazes.
   // Consecutive beams of a dense scan often stop in the same cell: their rays are traced once.

@@ -6,6 +6,14 @@
 // cell, and a continuous value and its gradient come from bilinear interpolation of the four
 // surrounding cells (eq. 4-6). Cell (i, j) is sampled at (i * resolution, j * resolution) in the
 // map frame. Log-odds are stored as 8-bit integers (1 byte plus 1 byte of update stamp per cell).
+//
+// Sub-cell hits (not in the paper; `subcell` on): a cell also keeps where in it the scans' end
+// points fell (their running mean, 6 bytes more per cell), and M(p) is read at p moved by the
+// occupancy-weighted mean of the four surrounding cells' offsets, so the map's ridge lies where
+// the walls were seen, not on the cell centres. Without it, a wall a small angle off the grid's
+// axes is a staircase of cells (one step every resolution / angle metres: 17 m at 5 cm and
+// 3 mrad), and matching a scan of it turns the pose until the wall runs along the axis
+// (docs/frontends.md, "The grid's axes pull the walls").
 #pragma once
 
 #include <Eigen/Core>
@@ -24,7 +32,8 @@ class OccupancyGrid {
   static constexpr int kTileCells = kTileSize * kTileSize;
 
   // p_occupied / p_free: probability of occupancy given a hit / a traversal (Hector 0.9 / 0.4).
-  OccupancyGrid(double resolution_m, double p_occupied, double p_free);
+  // subcell: keep the mean of the hits in each cell and read the map there (above).
+  OccupancyGrid(double resolution_m, double p_occupied, double p_free, bool subcell = false);
 
   double resolution() const { return resolution_m_; }
 
@@ -32,7 +41,13 @@ class OccupancyGrid {
   double cell_probability(int64_t ix, int64_t iy) const;
 
   // M(p) by bilinear interpolation (eq. 4) and, if `gradient` is given, dM/dp [1/m] (eq. 5-6).
+  // With sub-cell hits, M(p - o(p)) with o the hits' offset from the cell centres near p, and its
+  // gradient (I - do/dp)^T grad M.
   double value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient = nullptr) const;
+  // The offset o(p) of the hits near p from their cells' centres [m] (zero without sub-cell hits
+  // or where no cell near p is more likely occupied than not), and if asked do/dp.
+  Eigen::Vector2d hit_offset(const Eigen::Vector2d& p_map,
+                             Eigen::Matrix2d* jacobian = nullptr) const;
 
   // Integrates one scan seen from `origin_map`: cells on each ray become more likely free, the end
   // point's cell more likely occupied. Each cell is updated at most once per call and a hit wins
@@ -45,7 +60,7 @@ class OccupancyGrid {
 
   // Bytes held by the cells (tiles x tile size, and the tiles an open journal saved); the map's
   // memory use to report.
-  std::size_t memory_bytes() const { return (tiles_.size() + journal_saved_) * sizeof(Tile); }
+  std::size_t memory_bytes() const { return (tiles_.size() + journal_saved_) * tile_bytes(); }
   std::size_t tile_count() const { return tiles_.size(); }
   // Extent of the observed area [m]: min and max corner of all tiles, zero if empty.
   Eigen::Vector2d min_corner() const;
@@ -63,10 +78,27 @@ class OccupancyGrid {
   bool journal_open() const { return journal_open_; }
 
  private:
+  // Mean offset of a cell's hits from its centre, x and y in steps of resolution / kOffsetSteps
+  // (+-32767: just under half a cell), and how many hits the mean holds (capped, so the mean
+  // follows the latest hits).
+  struct SubcellHits {
+    int16_t x = 0, y = 0;
+    uint8_t count = 0;
+  };
   struct Tile {
     std::array<int8_t, kTileCells> log_odds{};  // in steps of kLogOddsStep
     std::array<uint8_t, kTileCells> stamp{};    // update() call that last touched the cell
+    // Sub-cell hits, one per cell when on (else empty).
+    std::vector<SubcellHits> subcell;
   };
+  static constexpr double kOffsetSteps = 65535.0;
+  std::size_t tile_bytes() const {
+    return sizeof(Tile) + (subcell_ ? kTileCells * sizeof(SubcellHits) : 0);
+  }
+  // Bilinear M(p) on the cell centres (eq. 4-6).
+  double interpolate(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const;
+  // Adds one hit at `cell_offset` (cells, each in [-0.5, 0.5]) to cell (ix, iy)'s mean.
+  void add_hit_offset(int64_t ix, int64_t iy, const Eigen::Vector2d& cell_offset);
   static uint64_t tile_key(int64_t tx, int64_t ty);
   const Tile* find_tile(int64_t tx, int64_t ty) const;
   Tile& tile_at(int64_t tx, int64_t ty);
@@ -75,6 +107,7 @@ class OccupancyGrid {
   void trace_free(int64_t x0, int64_t y0, int64_t x1, int64_t y1);
 
   double resolution_m_;
+  bool subcell_;
   int occupied_delta_;
   int free_delta_;
   std::array<float, 256> probability_of_{};  // indexed by log-odds + 128
