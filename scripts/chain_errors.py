@@ -74,29 +74,37 @@ def read(path, estimate, reference):
     return est, ref, closures, keys
 
 
-def key_pose_nees(keys, ref, times, frame_sigma, pose_sigma, scale=1.0, held=(0.0, 0.0)):
-    """NEES of each key pose's position error against its marginal (the reference aligned at the
-    first key pose): the graph's part (the published marginal less the terms `held` it was
-    published with) times `scale`, plus the two reporting terms."""
+def key_pose_errors(keys, ref, times):
+    """Per key pose but the first, (id, e, J): its position error e against the reference aligned
+    so that the first key pose is exact, and J, the lever of a turn of the frame about the first
+    key pose (d position / d heading). `keys`: id -> (utime, pose, ...)."""
     ids = sorted(keys)
     if len(ids) < 2:
         return []
-    u0, p0, _ = keys[ids[0]]
+    u0, p0 = keys[ids[0]][:2]
     g0 = interpolate(ref, times, u0)
     if g0 is None:
         return []
     out = []
     for i in ids[1:]:
-        u, p, C = keys[i]
+        u, p = keys[i][:2]
         g = interpolate(ref, times, u)
         if g is None:
             continue
-        # The truth in the map frame: aligned so that the first key pose is exact.
         rel = relative(g0, g)
-        t = p0[:2] + rot(p0[2]) @ rel[:2]
-        e = p[:2] - t
+        e = p[:2] - (p0[:2] + rot(p0[2]) @ rel[:2])
         r = p[:2] - p0[:2]
-        J = np.array([-r[1], r[0]])
+        out.append((i, e, np.array([-r[1], r[0]])))
+    return out
+
+
+def key_pose_nees(keys, ref, times, frame_sigma, pose_sigma, scale=1.0, held=(0.0, 0.0)):
+    """NEES of each key pose's position error against its marginal (the reference aligned at the
+    first key pose): the graph's part (the published marginal less the terms `held` it was
+    published with) times `scale`, plus the two reporting terms."""
+    out = []
+    for i, e, J in key_pose_errors(keys, ref, times):
+        C = keys[i][2]
         G = C[:2, :2] - held[0] ** 2 * np.outer(J, J) - held[1] ** 2 * np.eye(2)
         P = scale * G + frame_sigma ** 2 * np.outer(J, J) + pose_sigma ** 2 * np.eye(2)
         try:

@@ -64,23 +64,9 @@ def decompose(ref, keys, published_scale, pose_sigma, frame_sigma):
     """Per key pose but the first: (error e, lever J, graph marginal M, frame sigma), 2D position
     parts, M being the published covariance less the two terms, over published_scale."""
     times = [r[0] for r in ref]
-    ids = sorted(keys)
-    if len(ids) < 2:
-        return []
-    u0, p0, _, _ = keys[ids[0]]
-    g0 = chain_errors.interpolate(ref, times, u0)
-    if g0 is None:
-        return []
     rows = []
-    for i in ids[1:]:
-        u, p, C, sigma = keys[i]
-        g = chain_errors.interpolate(ref, times, u)
-        if g is None:
-            continue
-        rel = chain_errors.relative(g0, g)
-        e = p[:2] - (p0[:2] + chain_errors.rot(p0[2]) @ rel[:2])
-        r = p[:2] - p0[:2]
-        J = np.array([-r[1], r[0]])
+    for i, e, J in chain_errors.key_pose_errors(keys, ref, times):
+        _, _, C, sigma = keys[i]
         s = frame_sigma if sigma is None else sigma
         M = (C[:2, :2] - s * s * np.outer(J, J) - pose_sigma ** 2 * np.eye(2)) / published_scale
         rows.append((e, J, M, s))

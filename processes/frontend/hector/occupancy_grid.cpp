@@ -16,6 +16,10 @@ int log_odds_steps(double p) {
 
 int64_t floor_div_tile(int64_t i) { return i >> OccupancyGrid::kTileBits; }  // arithmetic shift
 int64_t in_tile(int64_t i) { return i & (OccupancyGrid::kTileSize - 1); }
+// Cells (x0..x0+1, y0..y0+1) all in one tile.
+bool in_one_tile(int64_t x0, int64_t y0) {
+  return in_tile(x0) < OccupancyGrid::kTileSize - 1 && in_tile(y0) < OccupancyGrid::kTileSize - 1;
+}
 
 }  // namespace
 
@@ -67,6 +71,12 @@ double OccupancyGrid::cell_probability(int64_t ix, int64_t iy) const {
   return probability_of_[t->log_odds[in_tile(iy) * kTileSize + in_tile(ix)] + 128];
 }
 
+OccupancyGrid::Corner OccupancyGrid::corner(const Eigen::Vector2d& p_map) const {
+  const double gx = p_map.x() / resolution_m_, gy = p_map.y() / resolution_m_;
+  const double fx0 = std::floor(gx), fy0 = std::floor(gy);
+  return {static_cast<int64_t>(fx0), static_cast<int64_t>(fy0), gx - fx0, gy - fy0};
+}
+
 double OccupancyGrid::value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const {
   if (!subcell_) return interpolate(p_map, gradient);
   Eigen::Matrix2d d_offset;
@@ -81,17 +91,13 @@ Eigen::Vector2d OccupancyGrid::hit_offset(const Eigen::Vector2d& p_map,
                                           Eigen::Matrix2d* jacobian) const {
   if (jacobian) jacobian->setZero();
   if (!subcell_) return Eigen::Vector2d::Zero();
-  const double gx = p_map.x() / resolution_m_, gy = p_map.y() / resolution_m_;
-  const double fx0 = std::floor(gx), fy0 = std::floor(gy);
-  const int64_t x0 = static_cast<int64_t>(fx0), y0 = static_cast<int64_t>(fy0);
-  const double fx = gx - fx0, fy = gy - fy0;
+  const auto [x0, y0, fx, fy] = corner(p_map);
   // Each of the four cells weighs by its bilinear weight times its occupied evidence (probability
   // above 0.5): free and unknown cells say nothing about where a wall lies. The weighted sum of
   // the offsets S and of the weights W, and their derivatives by fx and fy, give o = S / W.
   Eigen::Vector2d sum = Eigen::Vector2d::Zero(), dsum_dfx = sum, dsum_dfy = sum;
   double weight = 0.0, dweight_dfx = 0.0, dweight_dfy = 0.0;
-  // All four cells in one tile (the usual case): one look-up.
-  const bool one_tile = in_tile(x0) < kTileSize - 1 && in_tile(y0) < kTileSize - 1;
+  const bool one_tile = in_one_tile(x0, y0);  // the usual case: one look-up
   const Tile* tile = one_tile ? find_tile(floor_div_tile(x0), floor_div_tile(y0)) : nullptr;
   if (one_tile && !tile) return Eigen::Vector2d::Zero();
   for (int dy = 0; dy <= 1; ++dy) {
@@ -125,10 +131,8 @@ Eigen::Vector2d OccupancyGrid::hit_offset(const Eigen::Vector2d& p_map,
   return sum * (scale / weight);
 }
 
-void OccupancyGrid::add_hit_offset(int64_t ix, int64_t iy, const Eigen::Vector2d& cell_offset) {
+void OccupancyGrid::add_hit_offset(SubcellHits& h, const Eigen::Vector2d& cell_offset) {
   constexpr int kMaxCount = 32;  // the mean of about the last 32 hits
-  SubcellHits& h = tile_at(floor_div_tile(ix), floor_div_tile(iy))
-                       .subcell[in_tile(iy) * kTileSize + in_tile(ix)];
   const int n = std::min<int>(h.count, kMaxCount - 1) + 1;
   auto mean = [n](int16_t old, double offset_cells) {
     const double x = old + (offset_cells * kOffsetSteps - old) / n;
@@ -140,19 +144,15 @@ void OccupancyGrid::add_hit_offset(int64_t ix, int64_t iy, const Eigen::Vector2d
 }
 
 double OccupancyGrid::interpolate(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const {
-  const double gx = p_map.x() / resolution_m_, gy = p_map.y() / resolution_m_;
-  const double fx0 = std::floor(gx), fy0 = std::floor(gy);
-  const int64_t x0 = static_cast<int64_t>(fx0), y0 = static_cast<int64_t>(fy0);
-  const double fx = gx - fx0, fy = gy - fy0;
+  const auto [x0, y0, fx, fy] = corner(p_map);
   double m00, m10, m01, m11;
-  const int64_t lx = in_tile(x0), ly = in_tile(y0);
-  if (lx < kTileSize - 1 && ly < kTileSize - 1) {  // all four cells in one tile: one look-up
+  if (in_one_tile(x0, y0)) {  // all four cells in one tile: one look-up
     const Tile* t = find_tile(floor_div_tile(x0), floor_div_tile(y0));
     if (!t) {
       if (gradient) gradient->setZero();
       return 0.5;
     }
-    const int8_t* c = &t->log_odds[ly * kTileSize + lx];
+    const int8_t* c = &t->log_odds[in_tile(y0) * kTileSize + in_tile(x0)];
     m00 = probability_of_[c[0] + 128];
     m10 = probability_of_[c[1] + 128];
     m01 = probability_of_[c[kTileSize] + 128];
@@ -174,12 +174,14 @@ double OccupancyGrid::interpolate(const Eigen::Vector2d& p_map, Eigen::Vector2d*
   return (1.0 - fy) * bottom + fy * top;
 }
 
-void OccupancyGrid::touch(int64_t ix, int64_t iy, int delta) {
+OccupancyGrid::SubcellHits* OccupancyGrid::touch(int64_t ix, int64_t iy, int delta) {
   Tile& t = tile_at(floor_div_tile(ix), floor_div_tile(iy));
   const int64_t i = in_tile(iy) * kTileSize + in_tile(ix);
-  if (t.stamp[i] == stamp_) return;
+  SubcellHits* hits = subcell_ ? &t.subcell[i] : nullptr;
+  if (t.stamp[i] == stamp_) return hits;
   t.stamp[i] = stamp_;
   t.log_odds[i] = static_cast<int8_t>(std::clamp(t.log_odds[i] + delta, -kLogOddsMax, kLogOddsMax));
+  return hits;
 }
 
 void OccupancyGrid::trace_free(int64_t x0, int64_t y0, int64_t x1, int64_t y1) {
@@ -219,8 +221,9 @@ void OccupancyGrid::update(const Eigen::Vector2d& origin_map,
   // Hits first, so that the traversals below skip the cells this scan saw occupied.
   for (const auto& p : hits_map) {
     const auto [ix, iy] = cell(p);
-    touch(ix, iy, occupied_delta_);
-    if (subcell_) add_hit_offset(ix, iy, p / resolution_m_ - Eigen::Vector2d(ix, iy));
+    if (SubcellHits* hits = touch(ix, iy, occupied_delta_)) {
+      add_hit_offset(*hits, p / resolution_m_ - Eigen::Vector2d(ix, iy));
+    }
   }
   // Free space along each beam up to a cell short of the hit, further short when it grazes.
   // Consecutive beams of a dense scan often stop in the same cell: their rays are traced once.

@@ -95,15 +95,23 @@ class OccupancyGrid {
   std::size_t tile_bytes() const {
     return sizeof(Tile) + (subcell_ ? kTileCells * sizeof(SubcellHits) : 0);
   }
+  // The cell (x0, y0) at or below p and p's fractions of a cell beyond it: the four cells
+  // (x0..x0+1, y0..y0+1) around p and its bilinear weights.
+  struct Corner {
+    int64_t x0, y0;
+    double fx, fy;
+  };
+  Corner corner(const Eigen::Vector2d& p_map) const;
   // Bilinear M(p) on the cell centres (eq. 4-6).
   double interpolate(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const;
-  // Adds one hit at `cell_offset` (cells, each in [-0.5, 0.5]) to cell (ix, iy)'s mean.
-  void add_hit_offset(int64_t ix, int64_t iy, const Eigen::Vector2d& cell_offset);
+  // Adds one hit at `cell_offset` (cells, each in [-0.5, 0.5]) to a cell's mean.
+  static void add_hit_offset(SubcellHits& hits, const Eigen::Vector2d& cell_offset);
   static uint64_t tile_key(int64_t tx, int64_t ty);
   const Tile* find_tile(int64_t tx, int64_t ty) const;
   Tile& tile_at(int64_t tx, int64_t ty);
-  // Applies `delta` to cell (ix, iy) unless this update already touched it.
-  void touch(int64_t ix, int64_t iy, int delta);
+  // Applies `delta` to cell (ix, iy) unless this update already touched it; returns the cell's
+  // sub-cell record (null without sub-cell hits).
+  SubcellHits* touch(int64_t ix, int64_t iy, int delta);
   void trace_free(int64_t x0, int64_t y0, int64_t x1, int64_t y1);
 
   double resolution_m_;
