@@ -151,7 +151,7 @@ TEST(PreviewResend, StaysUnderItsCapAndCoversTheWholeRoute) {
   RecordProperty("points_kept", std::to_string(resend.points()));
   RecordProperty("cell_m", std::to_string(resend.cell_m()));
 
-  resend.restart();
+  resend.answer();
   std::vector<int> per_metre(201, 0);
   int64_t answered = 0, last_utime = 0;
   bool first_profile = false;
@@ -191,7 +191,7 @@ TEST(PreviewResend, InTheBackgroundKeepsTheWholeRouteToo) {
   EXPECT_LE(resend.bytes(), kCap);
   EXPECT_EQ(resend.counters().points_compacted, sent - resend.points());
   EXPECT_GT(resend.cell_m(), 0.05);
-  resend.restart();
+  resend.answer();
   std::vector<int> per_metre(201, 0);
   int64_t answered = 0, last_utime = 0;
   bool first_profile = false;
@@ -218,7 +218,7 @@ TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
   int64_t max_bytes[1] = {0};
   drive_corridor(0.0, 20.0, resend, max_bytes);
   const int64_t compactions = resend.counters().compactions;
-  resend.restart();
+  resend.answer();
   std::vector<PreviewProfile> got = resend.next(50);
   ASSERT_FALSE(got.empty());
   // More route arrives while the answer is paced out: the kept points are thinned again.
@@ -235,6 +235,96 @@ TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
     }
   }
   EXPECT_GT(answered, 0u);
+}
+
+// Points per profile time of everything `resend` has left to answer (an answer from the start).
+std::map<int64_t, std::size_t> drain(PreviewResend& resend, std::vector<int64_t>* order = nullptr) {
+  std::map<int64_t, std::size_t> n;
+  while (resend.resending()) {
+    for (const PreviewProfile& p : resend.next(50)) {
+      n[p.utime] += p.p_base_mm.size();
+      if (order) order->push_back(p.utime);
+    }
+  }
+  return n;
+}
+
+// Listeners that ask while an answer goes out join it instead of restarting it: it goes on to the
+// newest profile, then round from the oldest to where the last one joined (a second round if one
+// joins during the first). Each gets the whole store after asking, and a profile goes once per
+// listener that needed it, at most: three for the part before the third listener joined, two after.
+TEST(PreviewResend, ListenersWhoJoinAnAnswerUnderWayEachGetTheWholeStore) {
+  int64_t max_bytes[1] = {0};
+  const auto store = [&](bool more) {  // the same route, answered whole by a store of its own
+    PreviewResend copy(0.05, 64 << 20);
+    drive_corridor(0.0, 10.0, copy, max_bytes);
+    if (more) drive_corridor(10.05, 12.0, copy, max_bytes);
+    copy.answer();
+    return drain(copy);
+  };
+  const std::map<int64_t, std::size_t> kept_a = store(false), kept_b = store(true);
+  PreviewResend resend(0.05, 64 << 20);  // no thinning
+  drive_corridor(0.0, 10.0, resend, max_bytes);
+  std::vector<int64_t> order;
+  std::map<int64_t, std::size_t> after_a, after_b, after_c;  // points sent after each asked
+  const auto send = [&](std::size_t calls) {
+    for (std::size_t k = 0; k < calls && resend.resending(); ++k) {
+      for (const PreviewProfile& p : resend.next(50)) {
+        order.push_back(p.utime);
+        after_a[p.utime] += p.p_base_mm.size();
+        after_b[p.utime] += p.p_base_mm.size();
+        after_c[p.utime] += p.p_base_mm.size();
+      }
+    }
+  };
+  const PreviewResend::Mark a = resend.answer();
+  send(40);
+  drive_corridor(10.05, 12.0, resend, max_bytes);  // more route, sent live, while it goes out
+  after_b.clear();
+  after_c.clear();
+  const PreviewResend::Mark b = resend.answer();  // joins
+  const int64_t b_at = order.back();
+  EXPECT_FALSE(resend.went_round(a));
+  // On past the newest profile and round, to before where the second joined.
+  while (resend.resending() && !resend.went_round(a)) send(1);
+  send(10);
+  ASSERT_TRUE(resend.resending());
+  EXPECT_TRUE(resend.went_round(a));
+  EXPECT_FALSE(resend.went_round(b));
+  after_c.clear();
+  const PreviewResend::Mark c = resend.answer();  // joins in the second round
+  const int64_t c_at = order.back();
+  ASSERT_LT(c_at, b_at);
+  send(100000);
+  EXPECT_FALSE(resend.resending());
+  EXPECT_TRUE(resend.went_round(b));
+  EXPECT_TRUE(resend.went_round(c));
+
+  for (const auto& [kept, after] :
+       {std::pair{&kept_a, &after_a}, {&kept_b, &after_b}, {&kept_b, &after_c}}) {
+    int missed = 0;
+    for (const auto& [t, n] : *kept) missed += (*after)[t] < n;
+    EXPECT_EQ(missed, 0);
+  }
+  // after_a: everything sent. The profile the third joined in went twice and the part of it
+  // before the join a third time.
+  int wrong = 0;
+  for (const auto& [t, n] : kept_b) {
+    const std::size_t got = after_a[t];
+    wrong += t == c_at ? got < 2 * n || got > 3 * n : got != (t < c_at ? 3u : 2u) * n;
+  }
+  EXPECT_EQ(wrong, 0);
+  // Never restarted: in time order but for the two rounds, each back to the oldest profile.
+  std::vector<std::size_t> rounds;
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    if (order[i] < order[i - 1]) rounds.push_back(i);
+  }
+  ASSERT_EQ(rounds.size(), 2u);
+  for (std::size_t i : rounds) {
+    EXPECT_EQ(order[i - 1], kept_b.rbegin()->first);
+    EXPECT_EQ(order[i], kept_b.begin()->first);
+  }
+  EXPECT_LE(order.back(), c_at);
 }
 
 // A thinning pass coarsens the cells from their indices: the same cell as preview_cell() at twice
@@ -284,7 +374,7 @@ TEST(PreviewResend, AfterAPassEachCellHoldsItsEarliestPoint) {
     for (const PreviewProfile& s : sent) {
       for (const auto& q : s.p_base_mm) earliest.try_emplace(cell_of(s, q).value(), s.utime, q);
     }
-    resend.restart();
+    resend.answer();
     while (resend.resending()) {
       for (const PreviewProfile& k : resend.next(1000)) {
         for (const auto& q : k.p_base_mm) {
