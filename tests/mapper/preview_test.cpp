@@ -5,18 +5,21 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <random>
 
 #include "mapper.hpp"
+#include "preview_corridor.hpp"
 #include "preview_resend.hpp"
 
 namespace traverse::mapper {
 namespace {
 
-constexpr int64_t kT0 = 1'700'000'000'000'000;
+constexpr int64_t kT0 = kCorridorT0;
 
 TEST(CloudPreview, KeepsOnePointPerCellInTheBaseFrame) {
   CloudPreview preview({.channel = "CLOUD_PREVIEW", .cell_m = 0.1, .max_points_per_message = 3});
@@ -97,40 +100,6 @@ TEST(CloudPreview, ComesFromTheMappersPlacementOncePerProfile) {
   ASSERT_TRUE(mapper.set_segment(segment(0.3)));
   mapper.apply_moves();
   EXPECT_EQ(calls, 1);
-}
-
-// A corridor 3 m wide and 2.5 m high, driven straight along x for `length_m`: each profile is the
-// ring of walls, floor and ceiling 0.4 m ahead of the cart, every 2 cm, one profile per 5 cm of
-// travel (so each brings one new slice of cells, as a first pass through a building does), from
-// `from_m` to `to_m` at 1.5 m/s. The preview's groups go into `resend` as the mapper node does;
-// returns the points sent live.
-int64_t drive_corridor(double from_m, double to_m, PreviewResend& resend,
-                       int64_t max_bytes_seen[1]) {
-  CloudPreview preview({.channel = "CLOUD_PREVIEW", .cell_m = 0.05});
-  int64_t sent = 0;
-  for (int i = static_cast<int>(std::lround(from_m / 0.05)); 0.05 * i <= to_m; ++i) {
-    const Pose2 T(0.05 * i, 0.0, 0.0);
-    const float x = static_cast<float>(T.x() + 0.4);
-    std::vector<Eigen::Vector3f> ring;
-    for (float y = -1.5f; y <= 1.5f; y += 0.02f) {
-      ring.emplace_back(x, y, 0.0f);
-      ring.emplace_back(x, y, 2.5f);
-    }
-    for (float z = 0.0f; z <= 2.5f; z += 0.02f) {
-      ring.emplace_back(x, -1.5f, z);
-      ring.emplace_back(x, 1.5f, z);
-    }
-    preview.add(kT0 + i * 33'000, T, ring);
-    for (const auto& group : preview.take()) {
-      for (const PreviewProfile& p : group) {
-        sent += static_cast<int64_t>(p.p_base_mm.size());
-        resend.add(p);
-        max_bytes_seen[0] = std::max(max_bytes_seen[0], resend.bytes());
-      }
-    }
-    resend.poll();  // as the node does before each group (nothing without the background mode)
-  }
-  return sent;
 }
 
 // What a late viewer is sent after a long run: bounded by the cap however long the run, and a
@@ -237,94 +206,32 @@ TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
   EXPECT_GT(answered, 0u);
 }
 
-// Points per profile time of everything `resend` has left to answer (an answer from the start).
-std::map<int64_t, std::size_t> drain(PreviewResend& resend, std::vector<int64_t>* order = nullptr) {
-  std::map<int64_t, std::size_t> n;
+// A pass that ends while the answer is inside a profile sends that profile again from its first
+// point: its points moved, and what the pass kept of the rest of it is not lost.
+TEST(PreviewResend, APassInsideAProfileLosesNoneOfItsKeptPoints) {
+  PreviewResend resend(0.05, 2048);
+  PreviewProfile a{kT0, {}, Pose2()};
+  for (int16_t i = 0; i < 100; ++i) a.p_base_mm.push_back({static_cast<int16_t>(300 * i), 0, 0});
+  resend.add(a);  // 696 bytes
+  resend.answer();
+  std::vector<std::array<int16_t, 3>> got;
+  for (const PreviewProfile& p : resend.next(10)) {
+    got.insert(got.end(), p.p_base_mm.begin(), p.p_base_mm.end());
+  }
+  // Later profiles in a's cells, until the store passes its cap: thinned away (a's are earlier).
+  for (int j = 1; j <= 7; ++j) {
+    resend.add({kT0 + j * 1000, {a.p_base_mm.begin(), a.p_base_mm.begin() + 20}, Pose2()});
+  }
+  ASSERT_EQ(resend.counters().compactions, 1);
+  EXPECT_EQ(resend.profiles(), 1u);
   while (resend.resending()) {
-    for (const PreviewProfile& p : resend.next(50)) {
-      n[p.utime] += p.p_base_mm.size();
-      if (order) order->push_back(p.utime);
+    for (const PreviewProfile& p : resend.next(10)) {
+      got.insert(got.end(), p.p_base_mm.begin(), p.p_base_mm.end());
     }
   }
-  return n;
-}
-
-// Listeners that ask while an answer goes out join it instead of restarting it: it goes on to the
-// newest profile, then round from the oldest to where the last one joined (a second round if one
-// joins during the first). Each gets the whole store after asking, and a profile goes once per
-// listener that needed it, at most: three for the part before the third listener joined, two after.
-TEST(PreviewResend, ListenersWhoJoinAnAnswerUnderWayEachGetTheWholeStore) {
-  int64_t max_bytes[1] = {0};
-  const auto store = [&](bool more) {  // the same route, answered whole by a store of its own
-    PreviewResend copy(0.05, 64 << 20);
-    drive_corridor(0.0, 10.0, copy, max_bytes);
-    if (more) drive_corridor(10.05, 12.0, copy, max_bytes);
-    copy.answer();
-    return drain(copy);
-  };
-  const std::map<int64_t, std::size_t> kept_a = store(false), kept_b = store(true);
-  PreviewResend resend(0.05, 64 << 20);  // no thinning
-  drive_corridor(0.0, 10.0, resend, max_bytes);
-  std::vector<int64_t> order;
-  std::map<int64_t, std::size_t> after_a, after_b, after_c;  // points sent after each asked
-  const auto send = [&](std::size_t calls) {
-    for (std::size_t k = 0; k < calls && resend.resending(); ++k) {
-      for (const PreviewProfile& p : resend.next(50)) {
-        order.push_back(p.utime);
-        after_a[p.utime] += p.p_base_mm.size();
-        after_b[p.utime] += p.p_base_mm.size();
-        after_c[p.utime] += p.p_base_mm.size();
-      }
-    }
-  };
-  const PreviewResend::Mark a = resend.answer();
-  send(40);
-  drive_corridor(10.05, 12.0, resend, max_bytes);  // more route, sent live, while it goes out
-  after_b.clear();
-  after_c.clear();
-  const PreviewResend::Mark b = resend.answer();  // joins
-  const int64_t b_at = order.back();
-  EXPECT_FALSE(resend.went_round(a));
-  // On past the newest profile and round, to before where the second joined.
-  while (resend.resending() && !resend.went_round(a)) send(1);
-  send(10);
-  ASSERT_TRUE(resend.resending());
-  EXPECT_TRUE(resend.went_round(a));
-  EXPECT_FALSE(resend.went_round(b));
-  after_c.clear();
-  const PreviewResend::Mark c = resend.answer();  // joins in the second round
-  const int64_t c_at = order.back();
-  ASSERT_LT(c_at, b_at);
-  send(100000);
-  EXPECT_FALSE(resend.resending());
-  EXPECT_TRUE(resend.went_round(b));
-  EXPECT_TRUE(resend.went_round(c));
-
-  for (const auto& [kept, after] :
-       {std::pair{&kept_a, &after_a}, {&kept_b, &after_b}, {&kept_b, &after_c}}) {
-    int missed = 0;
-    for (const auto& [t, n] : *kept) missed += (*after)[t] < n;
-    EXPECT_EQ(missed, 0);
-  }
-  // after_a: everything sent. The profile the third joined in went twice and the part of it
-  // before the join a third time.
-  int wrong = 0;
-  for (const auto& [t, n] : kept_b) {
-    const std::size_t got = after_a[t];
-    wrong += t == c_at ? got < 2 * n || got > 3 * n : got != (t < c_at ? 3u : 2u) * n;
-  }
-  EXPECT_EQ(wrong, 0);
-  // Never restarted: in time order but for the two rounds, each back to the oldest profile.
-  std::vector<std::size_t> rounds;
-  for (std::size_t i = 1; i < order.size(); ++i) {
-    if (order[i] < order[i - 1]) rounds.push_back(i);
-  }
-  ASSERT_EQ(rounds.size(), 2u);
-  for (std::size_t i : rounds) {
-    EXPECT_EQ(order[i - 1], kept_b.rbegin()->first);
-    EXPECT_EQ(order[i], kept_b.begin()->first);
-  }
-  EXPECT_LE(order.back(), c_at);
+  int missed = 0;
+  for (const auto& p : a.p_base_mm) missed += std::find(got.begin(), got.end(), p) == got.end();
+  EXPECT_EQ(missed, 0);
 }
 
 // A thinning pass coarsens the cells from their indices: the same cell as preview_cell() at twice
