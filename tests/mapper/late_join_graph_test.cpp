@@ -190,10 +190,10 @@ class PreviewPacingTest : public GraphTest {
   std::vector<cloud_preview_t> preview_, again_;
 };
 
-// A burst from one requester gets one answer, a second requester is answered at once (the answer
-// starts again and goes whole to both), and a request from a requester whose answer is still going
-// out is dropped, even past its stretch, instead of restarting it; once the answer is out and the
-// stretch over, the same requester is answered again.
+// A burst from one requester gets one answer, a second requester is answered at once (it joins
+// the answer before any of it went out, so both get it whole once), and a request from a requester
+// whose answer is still going out is dropped, even past its stretch; once the answer is out and
+// the stretch over, the same requester is answered again.
 class BurstPacingTest : public PreviewPacingTest {
  protected:
   void configure(mapper::MapperConfig& c) override {
