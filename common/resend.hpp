@@ -60,8 +60,8 @@ struct ResendPacing {
   enum class Scope { kChannel, kRequester } scope = Scope::kRequester;
   // For an answer that goes out over time (the mapper's, paced by bytes: seconds for a whole
   // store): true while an answer that `requester` will get whole is still going out. Its request
-  // is then paced whatever the data time: answered, it would restart what the requester is being
-  // sent. Empty: every answer goes out at once.
+  // is then paced whatever the data time: answered, it would make the answer go round once more
+  // for what the requester is being sent anyway. Empty: every answer goes out at once.
   std::function<bool(const std::string& requester)> answering = nullptr;
 };
 

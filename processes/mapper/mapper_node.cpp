@@ -48,17 +48,23 @@ MapperNode::MapperNode(Bus& bus, const MapperConfig& config, const Eigen::Isomet
     // Live, a thinning pass runs on a thread of its own: this thread handles the messages.
     resend_store_ = std::make_unique<PreviewResend>(
         config_.preview.cell_m, config_.preview.resend_max_bytes, worker_thread);
+    // A requester is being answered until the answer has gone once round the store since it
+    // asked.
     const auto answering = [this](const std::string& requester) {
-      return resend_store_->resending() && answering_.count(requester) > 0;
+      const auto it = answering_.find(requester);
+      return it != answering_.end() && !resend_store_->went_round(it->second);
     };
     resend_ = std::make_unique<ResendAnswerer>(
         bus, std::vector<std::string>{config_.preview.channel},
         [this](const ResendRequest& r) {
-          // From the start, paced by publish_preview(): whoever the answer under way was going
-          // to has had its start, and now gets the whole again.
-          if (!resend_store_->resending()) answering_.clear();
-          answering_.insert(r.requester);
-          resend_store_->restart();
+          // Paced out by publish_preview(). An answer under way is joined, not restarted
+          // (PreviewResend::answer): everyone it goes to gets it in order, once.
+          if (resend_store_->resending()) {
+            ++resend_requests_joined_;
+          } else {
+            answering_.clear();
+          }
+          answering_[r.requester] = resend_store_->answer();
           return true;
         },
         ResendPacing{.min_us = config_.resend.pace_us(),
@@ -376,6 +382,7 @@ void MapperNode::report_counters() {
     counters_("preview_messages", preview_messages_);
     counters_("preview_sent_bytes", preview_sent_bytes_);
     resend_->report(counters_);
+    counters_("resend_requests_joined", resend_requests_joined_);
     counters_("resend_messages", resend_messages_);
     const PreviewResendCounters& r = resend_store_->counters();
     counters_("preview_resend_points", static_cast<double>(resend_store_->points()));

@@ -16,9 +16,10 @@
 // publish_preview() (640 KB/s) so as not to overflow the sockets of the viewer or of the other
 // processes, which receive every multicast message. Requests are paced per requester like the
 // densifier's (ResendPacing): at most one answer per resend.pace_s of profile time, a requester
-// not answered yet at once (the answer starts again from the oldest profile, and every requester
-// of the answer under way gets it whole), and a request from a requester whose answer is still
-// going out (a whole store takes seconds) is dropped, not restarted. What is kept for that is
+// not answered yet at once (one that asks while an answer goes out joins it: the answer goes on
+// to the newest profile, then round from the oldest to where it stood, never restarted), and a
+// request from a requester whose answer is still going out (a whole store takes seconds) is
+// dropped. What is kept for that is
 // capped (preview.resend_max_bytes) and thinned to a coarser grid beyond the cap
 // (preview_resend.hpp), so it follows the map, not the run; live, a thinning pass runs on a thread
 // of its own, so this thread's message handling never waits for it. In turn the node asks the
@@ -49,7 +50,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <thread>
 #include <variant>
@@ -138,11 +138,12 @@ class MapperNode {
   // the current pacing window.
   std::unique_ptr<PreviewResend> resend_store_;
   std::unique_ptr<ResendAnswerer> resend_;
-  std::set<std::string> answering_;   // the requesters the answer under way goes to whole
+  // The requesters of the answer under way, with where it stood when each asked.
+  std::map<std::string, PreviewResend::Mark> answering_;
   int64_t newest_profile_utime_ = 0;  // [us] the data time answers are paced by
   std::chrono::steady_clock::time_point resend_window_;
   std::size_t resend_window_bytes_ = 0;
-  double resend_messages_ = 0;
+  double resend_messages_ = 0, resend_requests_joined_ = 0;
   CounterSink counters_;
   // Handler side (LCM thread).
   std::map<int64_t, int32_t> revisions_;  // newest revision queued, by key_id_first

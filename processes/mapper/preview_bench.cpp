@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
   const double data_s = next_take;
 
   // What a viewer asking now is sent, in messages of max_points_per_message points.
-  resend.restart();
+  resend.answer();
   std::vector<tm::PreviewProfile> answer;
   int64_t answer_points = 0, answer_bytes = 0;
   while (resend.resending()) {

@@ -106,13 +106,13 @@ void PreviewResend::merge(Pass pass) {
   cell_m_ = pass.cell_m;
   pass_profiles_ = 0;
   pass_points_ = 0;
-  // An answer under way that was inside a profile goes on with the next one: the thinned
-  // profile's points are no longer where they were.
-  if (resending_ && next_point_ > 0) {
-    const auto it = kept_.upper_bound(next_utime_);
-    next_point_ = 0;
-    resending_ = it != kept_.end();
-    if (resending_) next_utime_ = it->first;
+  // An answer under way that was inside a profile goes on from that profile's first point: the
+  // thinned profile's points are no longer where they were (some go twice rather than none
+  // lost). A stop inside a profile moves to its end for the same reason.
+  if (resending_) {
+    next_.point = 0;
+    if (stop_.point > 0) stop_.point = std::numeric_limits<std::size_t>::max();
+    settle();
   }
 }
 
@@ -121,32 +121,61 @@ void PreviewResend::count_blocked(double s) {
   counters_.blocked_max_s = std::max(counters_.blocked_max_s, s);
 }
 
-void PreviewResend::restart() {
-  resending_ = points_ > 0;
-  next_utime_ = std::numeric_limits<int64_t>::min();
-  next_point_ = 0;
+PreviewResend::Mark PreviewResend::answer() {
+  if (resending_) {
+    // Joined: on to the newest profile, then round to here.
+    stop_ = next_;
+    wrapped_ = false;
+  } else {
+    resending_ = points_ > 0;
+    next_ = stop_ = {std::numeric_limits<int64_t>::min(), 0};
+    wrapped_ = false;
+    lap_ = 0;
+  }
+  return {lap_, next_};
+}
+
+bool PreviewResend::went_round(const Mark& mark) const {
+  return !resending_ || lap_ > mark.lap + 1 || (lap_ == mark.lap + 1 && next_ >= mark.at);
+}
+
+void PreviewResend::settle() {
+  auto it = kept_.lower_bound(next_.utime);
+  if (it != kept_.end() && it->first == next_.utime && next_.point >= it->second.p_base_mm.size()) {
+    ++it;
+  }
+  if (it == kept_.end() && !wrapped_) {
+    wrapped_ = true;
+    ++lap_;
+    it = kept_.begin();
+    next_ = {std::numeric_limits<int64_t>::min(), 0};
+  }
+  if (it == kept_.end()) {
+    resending_ = false;
+    return;
+  }
+  if (it->first != next_.utime) next_ = {it->first, 0};
+  resending_ = !wrapped_ || next_ < stop_;
 }
 
 std::vector<PreviewProfile> PreviewResend::next(std::size_t max_points) {
   std::vector<PreviewProfile> out;
-  if (!resending_ || pass_.valid()) return out;
+  if (pass_.valid()) return out;
+  if (resending_) settle();
   std::size_t n = 0;
-  auto it = kept_.lower_bound(next_utime_);
-  while (it != kept_.end() && n < max_points) {
+  while (resending_ && n < max_points) {
+    const auto it = kept_.find(next_.utime);  // settle() put the position on a kept profile
     const KeptProfile& k = it->second;
-    const std::size_t take = std::min(max_points - n, k.p_base_mm.size() - next_point_);
-    const auto first = k.p_base_mm.begin() + static_cast<std::ptrdiff_t>(next_point_);
+    std::size_t end = k.p_base_mm.size();
+    if (wrapped_ && stop_.utime == it->first) end = std::min(end, stop_.point);
+    const std::size_t take = std::min(max_points - n, end - next_.point);
+    const auto first = k.p_base_mm.begin() + static_cast<std::ptrdiff_t>(next_.point);
     out.push_back(
         {it->first, {first, first + static_cast<std::ptrdiff_t>(take)}, Pose2(k.x, k.y, k.theta)});
     n += take;
-    next_point_ += take;
-    if (next_point_ == k.p_base_mm.size()) {
-      ++it;
-      next_point_ = 0;
-    }
+    next_.point += take;
+    settle();
   }
-  resending_ = it != kept_.end();
-  if (resending_) next_utime_ = it->first;
   return out;
 }
 

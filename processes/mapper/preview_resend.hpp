@@ -60,12 +60,32 @@ class PreviewResend {
   // over its cap (not counted as blocked: the node never waits; the end of a bench or test does).
   void wait();
   bool thinning() const { return pass_.valid(); }
-  // A late listener asked: next() goes through everything kept from the oldest profile again.
-  void restart();
+  // Where an answer stands: the profile it sends next, and that profile's first point not sent.
+  struct Position {
+    int64_t utime = 0;      // [us]
+    std::size_t point = 0;  // index into the profile's kept points
+    friend auto operator<=>(const Position&, const Position&) = default;
+  };
+  // Where an answer stood when a listener asked: its round (`lap`) and its position in it.
+  struct Mark {
+    int64_t lap = 0;
+    Position at;
+  };
+  // A late listener asked. With no answer under way, next() goes through everything kept from
+  // the oldest profile. With one under way, it is not restarted (its listeners would get its start
+  // twice, and listeners joining one after another would keep it from ever ending): it goes on to
+  // the newest profile, then round from the oldest to where it stood now, so the newcomer gets
+  // the whole store after asking and nothing is sent more than once more than someone needs.
+  // Returns where the answer stood, for went_round().
+  Mark answer();
   bool resending() const { return resending_; }
-  // The next kept profiles of the answer in time order, at most `max_points` points (a profile
-  // with more continues in the next call); empty when the answer is complete or paused while a
-  // pass runs.
+  // Whether the answer has gone once round the store since `mark` (or is over): a listener that
+  // asked at `mark` has had everything.
+  bool went_round(const Mark& mark) const;
+  // The next kept profiles of the answer, at most `max_points` points (a profile with more
+  // continues in the next call): in time order to the newest profile, then, if someone joined on
+  // the way, in time order again from the oldest to where it joined; empty when the answer is
+  // complete or paused while a pass runs.
   std::vector<PreviewProfile> next(std::size_t max_points);
 
   double cell_m() const { return cell_m_; }  // [m] the grid the kept points are one per cell of
@@ -88,6 +108,9 @@ class PreviewResend {
   // The pass's result in place of what it was given, what arrived meanwhile added after it.
   void merge(Pass pass);
   void count_blocked(double s);
+  // Puts the answer's position on the profile it sends next: round to the oldest after the
+  // newest once, and the answer over where it comes back to its stop.
+  void settle();
 
   double cell_m_;
   int64_t max_bytes_;
@@ -98,8 +121,10 @@ class PreviewResend {
   std::size_t pass_profiles_ = 0;  // profiles handed to the pass under way
   int64_t pass_points_ = 0;        // ... and their points
   bool resending_ = false;
-  int64_t next_utime_ = 0;      // [us] the answer's next profile
-  std::size_t next_point_ = 0;  // ... and its first point not yet sent
+  Position next_;         // what the answer sends next
+  Position stop_;         // where it ends once round the store (the last listener's join)
+  bool wrapped_ = false;  // round past the newest profile since the last listener asked
+  int64_t lap_ = 0;       // times round past the newest profile in this answer
   PreviewResendCounters counters_;
 };
 

@@ -151,8 +151,11 @@ class PreviewPacingTest : public GraphTest {
     GraphTest::SetUp();
     bus_.subscribe<cloud_preview_t>(channels::kCloudPreview,
                                     [this](const cloud_preview_t& m) { preview_.push_back(m); });
-    bus_.subscribe<cloud_preview_t>(channels::full_channel(channels::kCloudPreview),
-                                    [this](const cloud_preview_t& m) { again_.push_back(m); });
+    // In any order, as the viewer reads it: an answer that goes round for a requester who joined
+    // goes back to the oldest profile.
+    bus_.subscribe<cloud_preview_t>(
+        channels::full_channel(channels::kCloudPreview),
+        [this](const cloud_preview_t& m) { again_.push_back(m); }, true);
   }
   void ask(const std::string& who) {
     request_resend(bus_, who, {channels::kCloudPreview});
@@ -187,10 +190,10 @@ class PreviewPacingTest : public GraphTest {
   std::vector<cloud_preview_t> preview_, again_;
 };
 
-// A burst from one requester gets one answer, a second requester is answered at once (the answer
-// starts again and goes whole to both), and a request from a requester whose answer is still going
-// out is dropped, even past its stretch, instead of restarting it; once the answer is out and the
-// stretch over, the same requester is answered again.
+// A burst from one requester gets one answer, a second requester is answered at once (it joins
+// the answer before any of it went out, so both get it whole once), and a request from a requester
+// whose answer is still going out is dropped, even past its stretch; once the answer is out and
+// the stretch over, the same requester is answered again.
 class BurstPacingTest : public PreviewPacingTest {
  protected:
   void configure(mapper::MapperConfig& c) override {
@@ -225,6 +228,73 @@ TEST_P(BurstPacingTest, ABurstGetsOneAnswerAndARequestWhileItGoesOutDoesNotResta
   EXPECT_EQ(counter("resend_requests_paced"), 4.0);
 }
 
+// A second requester that asks while an answer goes out joins it (PreviewResend::answer): the
+// answer is not restarted but goes on in time order to the newest profile, then round from the
+// oldest to where it stood when the second asked. Each gets every stored point after asking, and
+// no point goes more than twice.
+class JoinPacingTest : public BurstPacingTest {};
+
+TEST_P(JoinPacingTest, ASecondRequesterJoinsTheAnswerUnderWayInsteadOfRestartingIt) {
+  drive(300, true);  // 6 s of data
+  publish();
+  using Points = std::map<int64_t, std::vector<std::array<int16_t, 3>>>;
+  const Points stored_first = preview_points(preview_);  // the store when the first asks
+  ask("viewer");
+  publish();  // the answer's first window
+  const std::size_t before_join = again_.size();
+  ASSERT_GT(before_join, 0u);
+  ASSERT_LT(points(again_), points(preview_)) << "the answer went out at once: enlarge the store";
+  const int64_t joined_at = again_.back().profiles.back().utime;
+  drive(320, true, 301);  // 0.4 s of data later
+  const Points stored_second = preview_points(preview_);
+  ask("second-viewer");
+  finish_answer();
+  EXPECT_EQ(counter("resend_answers"), 2.0);
+  EXPECT_EQ(counter("resend_requests_joined"), 1.0);
+  EXPECT_EQ(counter("resend_requests_paced"), 0.0);
+
+  // Each requester gets every point stored when it asked, at least once after asking.
+  const auto count = [](const Points& points) {
+    std::map<std::pair<int64_t, std::array<int16_t, 3>>, int> n;
+    for (const auto& [t, pts] : points) {
+      for (const auto& p : pts) ++n[{t, p}];
+    }
+    return n;
+  };
+  const auto answered_first = count(preview_points(again_));
+  const auto answered_second = count(
+      preview_points({again_.begin() + static_cast<std::ptrdiff_t>(before_join), again_.end()}));
+  int missed_first = 0, missed_second = 0;
+  for (const auto& [key, n] : count(stored_first)) {
+    const auto it = answered_first.find(key);
+    missed_first += it == answered_first.end() || it->second < n;
+  }
+  for (const auto& [key, n] : count(stored_second)) {
+    const auto it = answered_second.find(key);
+    missed_second += it == answered_second.end() || it->second < n;
+  }
+  EXPECT_EQ(missed_first, 0);
+  EXPECT_EQ(missed_second, 0);
+  // No point more than twice as often as it was sent live.
+  const auto live = count(preview_points(preview_));
+  int over_twice = 0;
+  for (const auto& [key, n] : answered_first) over_twice += n > 2 * live.at(key);
+  EXPECT_EQ(over_twice, 0);
+
+  // Not restarted: in time order to the newest profile, then once round from the oldest, to no
+  // further than where the answer stood when the second asked.
+  std::vector<int64_t> order;
+  for (const cloud_preview_t& m : again_) {
+    for (const preview_profile_t& p : m.profiles) order.push_back(p.utime);
+  }
+  const auto round = std::is_sorted_until(order.begin(), order.end());
+  ASSERT_NE(round, order.end()) << "the answer never went round for the second requester";
+  EXPECT_EQ(*(round - 1), live.rbegin()->first.first) << "went round before the newest profile";
+  EXPECT_EQ(*round, live.begin()->first.first);
+  EXPECT_TRUE(std::is_sorted(round, order.end())) << "started again a second time";
+  EXPECT_LE(order.back(), joined_at);
+}
+
 // resend.pace_s of the mapper's config is the stretch: with 1 s, a request 0.5 s of data after
 // the answer is dropped, one 1.5 s after is answered (the default 5 s would drop it).
 class ConfiguredPacingTest : public PreviewPacingTest {
@@ -250,6 +320,9 @@ TEST_P(ConfiguredPacingTest, ARequestPastTheConfiguredStretchIsAnswered) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Mapper, BurstPacingTest, ::testing::Values(true, false),
+                         [](const auto& info) { return info.param ? "worker" : "inline"; });
+
+INSTANTIATE_TEST_SUITE_P(Mapper, JoinPacingTest, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "worker" : "inline"; });
 
 INSTANTIATE_TEST_SUITE_P(Mapper, ConfiguredPacingTest, ::testing::Values(true, false),

@@ -5,18 +5,21 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <random>
 
 #include "mapper.hpp"
+#include "preview_corridor.hpp"
 #include "preview_resend.hpp"
 
 namespace traverse::mapper {
 namespace {
 
-constexpr int64_t kT0 = 1'700'000'000'000'000;
+constexpr int64_t kT0 = kCorridorT0;
 
 TEST(CloudPreview, KeepsOnePointPerCellInTheBaseFrame) {
   CloudPreview preview({.channel = "CLOUD_PREVIEW", .cell_m = 0.1, .max_points_per_message = 3});
@@ -99,40 +102,6 @@ TEST(CloudPreview, ComesFromTheMappersPlacementOncePerProfile) {
   EXPECT_EQ(calls, 1);
 }
 
-// A corridor 3 m wide and 2.5 m high, driven straight along x for `length_m`: each profile is the
-// ring of walls, floor and ceiling 0.4 m ahead of the cart, every 2 cm, one profile per 5 cm of
-// travel (so each brings one new slice of cells, as a first pass through a building does), from
-// `from_m` to `to_m` at 1.5 m/s. The preview's groups go into `resend` as the mapper node does;
-// returns the points sent live.
-int64_t drive_corridor(double from_m, double to_m, PreviewResend& resend,
-                       int64_t max_bytes_seen[1]) {
-  CloudPreview preview({.channel = "CLOUD_PREVIEW", .cell_m = 0.05});
-  int64_t sent = 0;
-  for (int i = static_cast<int>(std::lround(from_m / 0.05)); 0.05 * i <= to_m; ++i) {
-    const Pose2 T(0.05 * i, 0.0, 0.0);
-    const float x = static_cast<float>(T.x() + 0.4);
-    std::vector<Eigen::Vector3f> ring;
-    for (float y = -1.5f; y <= 1.5f; y += 0.02f) {
-      ring.emplace_back(x, y, 0.0f);
-      ring.emplace_back(x, y, 2.5f);
-    }
-    for (float z = 0.0f; z <= 2.5f; z += 0.02f) {
-      ring.emplace_back(x, -1.5f, z);
-      ring.emplace_back(x, 1.5f, z);
-    }
-    preview.add(kT0 + i * 33'000, T, ring);
-    for (const auto& group : preview.take()) {
-      for (const PreviewProfile& p : group) {
-        sent += static_cast<int64_t>(p.p_base_mm.size());
-        resend.add(p);
-        max_bytes_seen[0] = std::max(max_bytes_seen[0], resend.bytes());
-      }
-    }
-    resend.poll();  // as the node does before each group (nothing without the background mode)
-  }
-  return sent;
-}
-
 // What a late viewer is sent after a long run: bounded by the cap however long the run, and a
 // picture of the whole route, the start included (the earliest point of each coarse cell is kept).
 TEST(PreviewResend, StaysUnderItsCapAndCoversTheWholeRoute) {
@@ -151,7 +120,7 @@ TEST(PreviewResend, StaysUnderItsCapAndCoversTheWholeRoute) {
   RecordProperty("points_kept", std::to_string(resend.points()));
   RecordProperty("cell_m", std::to_string(resend.cell_m()));
 
-  resend.restart();
+  resend.answer();
   std::vector<int> per_metre(201, 0);
   int64_t answered = 0, last_utime = 0;
   bool first_profile = false;
@@ -191,7 +160,7 @@ TEST(PreviewResend, InTheBackgroundKeepsTheWholeRouteToo) {
   EXPECT_LE(resend.bytes(), kCap);
   EXPECT_EQ(resend.counters().points_compacted, sent - resend.points());
   EXPECT_GT(resend.cell_m(), 0.05);
-  resend.restart();
+  resend.answer();
   std::vector<int> per_metre(201, 0);
   int64_t answered = 0, last_utime = 0;
   bool first_profile = false;
@@ -218,7 +187,7 @@ TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
   int64_t max_bytes[1] = {0};
   drive_corridor(0.0, 20.0, resend, max_bytes);
   const int64_t compactions = resend.counters().compactions;
-  resend.restart();
+  resend.answer();
   std::vector<PreviewProfile> got = resend.next(50);
   ASSERT_FALSE(got.empty());
   // More route arrives while the answer is paced out: the kept points are thinned again.
@@ -235,6 +204,34 @@ TEST(PreviewResend, AnAnswerUnderWayGoesOnThroughACompaction) {
     }
   }
   EXPECT_GT(answered, 0u);
+}
+
+// A pass that ends while the answer is inside a profile sends that profile again from its first
+// point: its points moved, and what the pass kept of the rest of it is not lost.
+TEST(PreviewResend, APassInsideAProfileLosesNoneOfItsKeptPoints) {
+  PreviewResend resend(0.05, 2048);
+  PreviewProfile a{kT0, {}, Pose2()};
+  for (int16_t i = 0; i < 100; ++i) a.p_base_mm.push_back({static_cast<int16_t>(300 * i), 0, 0});
+  resend.add(a);  // 696 bytes
+  resend.answer();
+  std::vector<std::array<int16_t, 3>> got;
+  for (const PreviewProfile& p : resend.next(10)) {
+    got.insert(got.end(), p.p_base_mm.begin(), p.p_base_mm.end());
+  }
+  // Later profiles in a's cells, until the store passes its cap: thinned away (a's are earlier).
+  for (int j = 1; j <= 7; ++j) {
+    resend.add({kT0 + j * 1000, {a.p_base_mm.begin(), a.p_base_mm.begin() + 20}, Pose2()});
+  }
+  ASSERT_EQ(resend.counters().compactions, 1);
+  EXPECT_EQ(resend.profiles(), 1u);
+  while (resend.resending()) {
+    for (const PreviewProfile& p : resend.next(10)) {
+      got.insert(got.end(), p.p_base_mm.begin(), p.p_base_mm.end());
+    }
+  }
+  int missed = 0;
+  for (const auto& p : a.p_base_mm) missed += std::find(got.begin(), got.end(), p) == got.end();
+  EXPECT_EQ(missed, 0);
 }
 
 // A thinning pass coarsens the cells from their indices: the same cell as preview_cell() at twice
@@ -284,7 +281,7 @@ TEST(PreviewResend, AfterAPassEachCellHoldsItsEarliestPoint) {
     for (const PreviewProfile& s : sent) {
       for (const auto& q : s.p_base_mm) earliest.try_emplace(cell_of(s, q).value(), s.utime, q);
     }
-    resend.restart();
+    resend.answer();
     while (resend.resending()) {
       for (const PreviewProfile& k : resend.next(1000)) {
         for (const auto& q : k.p_base_mm) {
