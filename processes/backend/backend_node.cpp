@@ -270,6 +270,8 @@ void BackendNode::report_counters() {
   const OdometryCounters& o = backend_.odometry_counters();
   counters_("odometry_readings", static_cast<double>(o.readings));
   counters_("odometry_out_of_order", static_cast<double>(o.readings_out_of_order));
+  counters_("odometry_implausible", static_cast<double>(o.readings_implausible));
+  counters_("odometry_steps_implausible", static_cast<double>(o.steps_implausible));
   counters_("odometry_steps_checked", static_cast<double>(o.steps_checked));
   counters_("odometry_steps_contradicted", static_cast<double>(o.steps_contradicted));
   counters_("frontend_steps_replaced_by_odometry", static_cast<double>(c.frontend_steps_replaced));

@@ -18,6 +18,8 @@ std::optional<std::string> validate(const OdometryCheckConfig& c) {
   check.positive("max_frontend_chi2", c.max_frontend_chi2);
   check.positive("max_reading_gap_us", c.max_reading_gap_us);
   check.positive("keep_us", c.keep_us);
+  check.positive("max_speed_mps", c.max_speed_mps);
+  check.positive("max_turn_rate_radps", c.max_turn_rate_radps);
   return check.problem();
 }
 
@@ -45,8 +47,19 @@ void OdometryCheck::add(int64_t utime, const Pose2& T_odom_base) {
     return;
   }
   ++counters_.readings;
+  if (!readings_.empty()) {
+    const double dt = 1e-6 * static_cast<double>(utime - readings_.back().first);
+    const Pose2 step = between(readings_.back().second, T_odom_base);
+    if (step.translation().norm() > config_.max_speed_mps * dt ||
+        std::abs(step.theta()) > config_.max_turn_rate_radps * dt) {
+      ++counters_.readings_implausible;
+      implausible_.push_back(utime);
+    }
+  }
   readings_.emplace_back(utime, T_odom_base);
   while (readings_.front().first < utime - config_.keep_us) readings_.pop_front();
+  while (!implausible_.empty() && implausible_.front() < utime - config_.keep_us)
+    implausible_.pop_front();
 }
 
 std::optional<Pose2> OdometryCheck::at(int64_t utime) const {
@@ -76,6 +89,12 @@ std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utim
   if (!config_.enabled) return std::nullopt;
   const std::optional<Pose2> a = at(a_utime), b = at(b_utime);
   if (!a || !b) return std::nullopt;
+  const auto near = std::lower_bound(implausible_.begin(), implausible_.end(),
+                                     a_utime - config_.max_reading_gap_us);
+  if (near != implausible_.end() && *near <= b_utime + config_.max_reading_gap_us) {
+    ++counters_.steps_implausible;
+    return std::nullopt;
+  }
   ++counters_.steps_checked;
   OdometryStep step;
   step.motion = between(*a, *b);

@@ -40,6 +40,14 @@ struct OdometryCheckConfig {
   double max_frontend_chi2 = 16.3;      // frontend step vs odometry beyond this: rejected
   int64_t max_reading_gap_us = 500000;  // [us] a key pose's time this far from any reading: none
   int64_t keep_us = 120'000'000;        // [us] readings kept this long behind the newest
+  // A reading that implies a speed or a turn rate above these since the one before says the
+  // stream's stamps do not follow the motion (Kummerle's intel: bursts of readings stamped within
+  // a millisecond after half a second without any, and two runs of readings interleaved, 0.2 m
+  // apart; 16,611 of its 26,915 readings imply over 3 m/s, none of aces' or fr079's). No step
+  // whose readings lie within max_reading_gap_us of such a reading is checked: its odometry step
+  // says nothing about the motion.
+  double max_speed_mps = 3.0;          // [m/s]
+  double max_turn_rate_radps = 6.0;    // [rad/s]
 
   template <class V>
   void visit(V& v) {
@@ -52,6 +60,8 @@ struct OdometryCheckConfig {
     v("max_frontend_chi2", max_frontend_chi2);
     v("max_reading_gap_us", max_reading_gap_us);
     v("keep_us", keep_us);
+    v("max_speed_mps", max_speed_mps);
+    v("max_turn_rate_radps", max_turn_rate_radps);
   }
 };
 
@@ -61,6 +71,8 @@ std::optional<std::string> validate(const OdometryCheckConfig& config);
 struct OdometryCounters {
   long readings = 0;               // odometry messages taken
   long readings_out_of_order = 0;  // ... dropped: not later than the one before
+  long readings_implausible = 0;   // ... kept, but over max_speed_mps or max_turn_rate_radps
+  long steps_implausible = 0;      // key steps not checked: an implausible reading nearby
   long steps_checked = 0;          // key steps with odometry at both ends
   long steps_contradicted = 0;     // ... where the frontend's step failed the gate
 };
@@ -110,6 +122,7 @@ class OdometryCheck {
   OdometryCheckConfig config_;
   OdometryCounters counters_;
   std::deque<std::pair<int64_t, Pose2>> readings_;
+  std::deque<int64_t> implausible_;  // times of implausible readings, kept as long as readings
 };
 
 }  // namespace traverse::backend

@@ -24,6 +24,7 @@ std::optional<std::string> validate(const DensifierConfig& c) {
   check.not_negative("spike_threshold_m", c.spike_threshold_m);
   check.not_negative("spike_max_span_us", c.spike_max_span_us);
   check.not_negative("spike_min_interval_us", c.spike_min_interval_us);
+  check.not_negative("spike_interval_tolerance", c.spike_interval_tolerance);
   check.nested("resend", validate(c.resend));
   return check.problem();
 }
@@ -160,6 +161,21 @@ bool Densifier::add_dense(int64_t utime, const Pose2& T_world_base, std::vector<
   return true;
 }
 
+bool Densifier::steady(int64_t in_us, int64_t out_us) const {
+  constexpr std::size_t kPeriods = 20;
+  const std::size_t n = dense_.size();
+  std::vector<int64_t> intervals;
+  for (std::size_t i = n - 1; i > 0 && intervals.size() < kPeriods; --i) {
+    intervals.push_back(dense_[i].utime - dense_[i - 1].utime);
+  }
+  const auto mid = intervals.begin() + static_cast<std::ptrdiff_t>(intervals.size() / 2);
+  std::nth_element(intervals.begin(), mid, intervals.end());
+  const double period = static_cast<double>(*mid);
+  const double tolerance = config_.spike_interval_tolerance * period;
+  return std::abs(static_cast<double>(in_us) - period) <= tolerance &&
+         std::abs(static_cast<double>(out_us) - period) <= tolerance;
+}
+
 void Densifier::replace_spike(std::vector<Segment>& out) {
   const std::size_t n = dense_.size();
   if (config_.spike_threshold_m <= 0.0 || n < 3) return;
@@ -170,7 +186,7 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   const int64_t in = p.utime - a.utime, out_us = b.utime - p.utime;
   if (std::min(in, out_us) < config_.spike_min_interval_us) return;
   // A scanner's stream comes at a steady rate; uneven intervals are a log's restamped times.
-  if (std::max(in, out_us) > 2 * std::min(in, out_us)) return;
+  if (!steady(in, out_us)) return;
   const Pose2 q = interpolate_between(a, b, p.utime);
   const double off = (p.T_world_base.translation() - q.translation()).norm();
   // Turns count as travel, as the bending counts them (turn_lever_m): a turn moves the base's

@@ -297,6 +297,29 @@ TEST(OdometryCheck, InterpolatesBetweenReadingsAndKnowsItsGaps) {
   EXPECT_FALSE(check.check(0, 1'000'000, Pose2(), none));          // 1 s before the first reading
 }
 
+// Readings whose stamps do not follow the motion (Kummerle's intel: a burst of readings 3 cm
+// apart stamped within a millisecond, after half a second without any) say nothing about the
+// steps around them: those are not checked, and counted. Steps clear of them still are.
+TEST(OdometryCheck, StepsNearReadingsOfImplausibleSpeedAreNotChecked) {
+  OdometryCheck check{OdometryCheckConfig{}};
+  for (int i = 0; i <= 20; ++i) check.add(1'000'000 + i * 100'000, Pose2(0.03 * i, 0.0, 0.0));
+  EXPECT_EQ(check.counters().readings_implausible, 0);
+  check.add(3'000'200, Pose2(0.63, 0.0, 0.0));  // 3 cm in 0.2 ms: 150 m/s
+  check.add(3'000'400, Pose2(0.66, 0.0, 0.0));
+  check.add(3'100'000, Pose2(0.69, 0.0, 0.0));
+  check.add(3'200'000, Pose2(0.72, 0.0, 0.0));
+  check.add(3'200'100, Pose2(0.72, 0.0, 1.0));  // a turn of 1 rad in 0.1 ms
+  EXPECT_EQ(check.counters().readings_implausible, 3);
+  const Eigen::Matrix3d none = Eigen::Matrix3d::Zero();
+  EXPECT_FALSE(check.check(2'800'000, 3'100'000, Pose2(0.09, 0.0, 0.0), none));
+  EXPECT_FALSE(check.check(2'300'000, 2'600'000, Pose2(0.09, 0.0, 0.0), none));  // 0.4 s before
+  EXPECT_EQ(check.counters().steps_implausible, 2);
+  const auto clear = check.check(1'000'000, 1'300'000, Pose2(0.09, 0.0, 0.0), none);
+  ASSERT_TRUE(clear);
+  EXPECT_NEAR(clear->motion.x(), 0.09, 1e-9);
+  EXPECT_EQ(check.counters().steps_checked, 1);
+}
+
 TEST(Backend, ConfigValidation) {
   BackendConfig config;
   EXPECT_EQ(validate(config), std::nullopt);
