@@ -46,8 +46,8 @@ struct OdometryCheckConfig {
   // apart; 16,611 of its 26,915 readings imply over 3 m/s, none of aces' or fr079's). No step
   // whose readings lie within max_reading_gap_us of such a reading is checked: its odometry step
   // says nothing about the motion.
-  double max_speed_mps = 3.0;          // [m/s]
-  double max_turn_rate_radps = 6.0;    // [rad/s]
+  double max_speed_mps = 3.0;        // [m/s]
+  double max_turn_rate_radps = 6.0;  // [rad/s]
 
   template <class V>
   void visit(V& v) {
