@@ -2,6 +2,7 @@
 """The backend's loop closures on a Kummerle log, checked against the benchmark's relations.
 
     scripts/closure_relations.py RUN_DIR_OR_LOG RELATIONS [--window-s S] [--sigmas K]
+                                 [--build-dir DIR]
 
 RUN_DIR_OR_LOG is an eval-kummerle.sh output folder of a run with the backend (its run.lcmlog)
 or such a log; RELATIONS the benchmark's relations file (../shared/data/kummerle/NAME.relations:
@@ -65,9 +66,9 @@ def mahalanobis(e, c):
     return math.sqrt(max(0.0, sum(e[i] * x[i] for i in range(3))))
 
 
-def read_run(path):
+def read_run(path, build_dir=None):
     """Frontend poses {utime: (x, y, theta)} and the newest copy of each closure by key ids."""
-    types = lcmlog.message_types()
+    types = lcmlog.message_types(build_dir)
     frontend, closures = {}, {}
     for _, _, channel, data in lcmlog.events(path, channels={"POSE_FRONTEND", "KEY_POSES"}):
         if data is None:
@@ -99,9 +100,10 @@ def main():
     ap.add_argument("relations")
     ap.add_argument("--window-s", type=float, default=2.0)
     ap.add_argument("--sigmas", type=float, default=5.0)
+    ap.add_argument("--build-dir", help="build folder with the generated types (default: build/)")
     a = ap.parse_args()
     log = os.path.join(a.run, "run.lcmlog") if os.path.isdir(a.run) else a.run
-    frontend, closures = read_run(log)
+    frontend, closures = read_run(log, a.build_dir)
     if not frontend:
         sys.exit(f"{log}: no POSE_FRONTEND")
     times = sorted(frontend)
