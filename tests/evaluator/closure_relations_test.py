@@ -91,6 +91,9 @@ class ClosureRelationsTest(unittest.TestCase):
             self.assertAlmostEqual(summary["max_error_m"], 0.3, delta=0.005)
             self.assertGreater(summary["max_sigmas"], 10.0)
             self.assertIn("100 -> 500: error 0.000 m", out)
+            # The frontend lies on the truth: no closure is nearer to it.
+            self.assertLess(summary["frontend_median_error_m"], 1e-4)
+            self.assertEqual(summary["closure_nearer"], 0)
 
 
 if __name__ == "__main__":
