@@ -2,6 +2,7 @@
 """The backend's loop closures on a Kummerle log, checked against the benchmark's relations.
 
     scripts/closure_relations.py RUN_DIR_OR_LOG RELATIONS [--window-s S] [--sigmas K]
+                                 [--build-dir DIR]
 
 RUN_DIR_OR_LOG is an eval-kummerle.sh output folder of a run with the backend (its run.lcmlog)
 or such a log; RELATIONS the benchmark's relations file (../shared/data/kummerle/NAME.relations:
@@ -17,8 +18,12 @@ relation, and the frontend's motion from its other scan to the second key pose,
 so the frontend's drift over at most two windows enters the check (a few centimetres at most on
 these logs; the errors below are bounds more than exact values). The error is the one the pose
 graph minimises, e = t2v(Z^-1 T_true), and its Mahalanobis distance uses the closure's published
-covariance. Prints the largest errors; the last line is JSON: closures, checked, median and
-largest error [m, deg], and how many lie over --sigmas (default 5) standard deviations.
+covariance. Beside it, the error of the frontend's own relative pose between the same two key
+poses, F(from)^-1 F(to), against the same truth: a closure can only straighten the path where it
+is nearer the truth than that. Prints the closures farthest from the truth in sigmas; the last
+line is JSON: closures, checked, median and largest error [m, deg], how many lie over --sigmas
+(default 5) standard deviations, the frontend's median error over the same pairs [m, deg] and in
+how many pairs the closure is nearer the truth than the frontend (closure_nearer).
 """
 import argparse
 import bisect
@@ -65,9 +70,9 @@ def mahalanobis(e, c):
     return math.sqrt(max(0.0, sum(e[i] * x[i] for i in range(3))))
 
 
-def read_run(path):
+def read_run(path, build_dir=None):
     """Frontend poses {utime: (x, y, theta)} and the newest copy of each closure by key ids."""
-    types = lcmlog.message_types()
+    types = lcmlog.message_types(build_dir)
     frontend, closures = {}, {}
     for _, _, channel, data in lcmlog.events(path, channels={"POSE_FRONTEND", "KEY_POSES"}):
         if data is None:
@@ -99,9 +104,10 @@ def main():
     ap.add_argument("relations")
     ap.add_argument("--window-s", type=float, default=2.0)
     ap.add_argument("--sigmas", type=float, default=5.0)
+    ap.add_argument("--build-dir", help="build folder with the generated types (default: build/)")
     a = ap.parse_args()
     log = os.path.join(a.run, "run.lcmlog") if os.path.isdir(a.run) else a.run
-    frontend, closures = read_run(log)
+    frontend, closures = read_run(log, a.build_dir)
     if not frontend:
         sys.exit(f"{log}: no POSE_FRONTEND")
     times = sorted(frontend)
@@ -129,11 +135,14 @@ def main():
         truth = compose(compose(to_a, rel), from_b)
         e = compose(inverse((c.x, c.y, c.theta)), truth)
         sigmas = mahalanobis(e, list(c.covariance))
-        checks.append((from_id, to_id, math.hypot(e[0], e[1]), math.degrees(e[2]), sigmas))
+        f = compose(inverse(compose(inverse(pose_near(c.from_utime)), pose_near(c.utime))), truth)
+        checks.append((from_id, to_id, math.hypot(e[0], e[1]), math.degrees(e[2]), sigmas,
+                       math.hypot(f[0], f[1]), math.degrees(f[2])))
     print(f"{len(closures)} closures, {len(checks)} with a relation within {a.window_s} s of both "
           f"key poses")
-    for f, t, err_m, err_deg, s in sorted(checks, key=lambda x: -x[4])[:8]:
-        print(f"  {f} -> {t}: error {err_m:.3f} m, {err_deg:+.2f} deg, {s:.1f} sigmas")
+    for f, t, err_m, err_deg, s, fe_m, fe_deg in sorted(checks, key=lambda x: -x[4])[:8]:
+        print(f"  {f} -> {t}: error {err_m:.3f} m, {err_deg:+.2f} deg, {s:.1f} sigmas "
+              f"(frontend {fe_m:.3f} m, {fe_deg:+.2f} deg)")
     summary = {"closures": len(closures), "checked": len(checks), "window_s": a.window_s,
                "sigmas": a.sigmas}
     if checks:
@@ -143,7 +152,10 @@ def main():
             "median_error_deg": round(statistics.median(abs(x[3]) for x in checks), 3),
             "max_error_deg": round(max(abs(x[3]) for x in checks), 3),
             "max_sigmas": round(max(x[4] for x in checks), 2),
-            "over_sigmas": sum(x[4] > a.sigmas for x in checks)})
+            "over_sigmas": sum(x[4] > a.sigmas for x in checks),
+            "frontend_median_error_m": round(statistics.median(x[5] for x in checks), 4),
+            "frontend_median_error_deg": round(statistics.median(abs(x[6]) for x in checks), 3),
+            "closure_nearer": sum(x[2] + 1e-6 < x[5] for x in checks)})  # by over 1 um
     print(json.dumps(summary))
 
 
