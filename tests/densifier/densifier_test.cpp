@@ -281,7 +281,7 @@ TEST(Densifier, SpikesAreLookedForOnlyWhereTheStreamIsSteady) {
   };
   EXPECT_EQ(run(89'000, 59'000), 0);
   EXPECT_EQ(run(100'000, 100'000), 1);
-  EXPECT_EQ(run(110'000, 90'000), 1);  // within 25 % of the period
+  EXPECT_EQ(run(130'000, 70'000), 1);  // within 35 % of the period (a simulated scanner's jitter)
 }
 
 }  // namespace
