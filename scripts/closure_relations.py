@@ -51,22 +51,21 @@ def inverse(a):
     return (-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2])
 
 
+def det3(m):
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
 def mahalanobis(e, c):
     """sqrt(e^T C^-1 e) for a 3x3 covariance C given row-major; nan when C is singular."""
     m = [c[0:3], c[3:6], c[6:9]]
-    det = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-           - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-           + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+    det = det3(m)
     if not det > 0.0:
         return float("nan")
     # C^-1 e by Cramer's rule: replace each column of C by e in turn.
-    x = []
-    for k in range(3):
-        mk = [[e[i] if j == k else m[i][j] for j in range(3)] for i in range(3)]
-        dk = (mk[0][0] * (mk[1][1] * mk[2][2] - mk[1][2] * mk[2][1])
-              - mk[0][1] * (mk[1][0] * mk[2][2] - mk[1][2] * mk[2][0])
-              + mk[0][2] * (mk[1][0] * mk[2][1] - mk[1][1] * mk[2][0]))
-        x.append(dk / det)
+    x = [det3([[e[i] if j == k else m[i][j] for j in range(3)] for i in range(3)]) / det
+         for k in range(3)]
     return math.sqrt(max(0.0, sum(e[i] * x[i] for i in range(3))))
 
 

@@ -185,8 +185,6 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   if (b.utime - a.utime > config_.spike_max_span_us) return;
   const int64_t in = p.utime - a.utime, out_us = b.utime - p.utime;
   if (std::min(in, out_us) < config_.spike_min_interval_us) return;
-  // A scanner's stream comes at a steady rate; uneven intervals are a log's restamped times.
-  if (!steady(in, out_us)) return;
   const Pose2 q = interpolate_between(a, b, p.utime);
   const double off = (p.T_world_base.translation() - q.translation()).norm();
   // Turns count as travel, as the bending counts them (turn_lever_m): a turn moves the base's
@@ -200,6 +198,9 @@ void Densifier::replace_spike(std::vector<Segment>& out) {
   const double travel = (b.T_world_base.translation() - a.T_world_base.translation()).norm() +
                         lever(a.T_world_base, b.T_world_base);
   if (off <= config_.spike_threshold_m || off <= travel || off <= lever(q, p.T_world_base)) return;
+  // A scanner's stream comes at a steady rate; uneven intervals are a log's restamped times.
+  // Checked last: it looks at the last 20 intervals, and few poses get this far.
+  if (!steady(in, out_us)) return;
   p.T_world_base = q;
   ++spikes_replaced_;
   // The segment over the pose, and the one before when a key pose sits exactly on it.
