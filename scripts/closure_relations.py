@@ -24,8 +24,8 @@ error is the one the pose graph minimises, e = t2v(Z^-1 T_true), and its Mahalan
 uses the closure's published covariance plus the truth's. Beside it, the error of the frontend's own relative pose between the same two key
 poses, F(from)^-1 F(to), against the same truth: a closure can only straighten the path where it
 is nearer the truth than that. Prints the closures farthest from the truth in sigmas; the last
-line is JSON: closures, checked, median and largest error [m, deg], how many lie over --sigmas
-(default 5) standard deviations, the frontend's median error over the same pairs [m, deg] and in
+line is JSON: closures, checked, median and largest error [m, deg], the median and largest
+Mahalanobis distance (median_sigmas, max_sigmas), how many lie over --sigmas (default 5), the frontend's median error over the same pairs [m, deg] and in
 how many pairs the closure is nearer the truth than the frontend (closure_nearer).
 """
 import argparse
@@ -191,6 +191,8 @@ def main():
             "median_error_deg": round(statistics.median(abs(x[3]) for x in checks), 3),
             "max_error_deg": round(max(abs(x[3]) for x in checks), 3),
             "max_sigmas": round(max(x[4] for x in checks), 2),
+            # 1.54 (sqrt of chi-square 3's median) when the covariances are right
+            "median_sigmas": round(statistics.median(x[4] for x in checks), 2),
             "over_sigmas": sum(x[4] > a.sigmas for x in checks),
             "frontend_median_error_m": round(statistics.median(x[5] for x in checks), 4),
             "frontend_median_error_deg": round(statistics.median(abs(x[6]) for x in checks), 3),
