@@ -15,14 +15,17 @@ relation, and the frontend's motion from its other scan to the second key pose,
 
     T_true = F(from)^-1 F(t1) * R(t1, t2) * F(t2)^-1 F(to),
 
-so the frontend's drift over at most two windows enters the check (a few centimetres at most on
-these logs; the errors below are bounds more than exact values). The error is the one the pose
-graph minimises, e = t2v(Z^-1 T_true), and its Mahalanobis distance uses the closure's published
-covariance. Beside it, the error of the frontend's own relative pose between the same two key
+so the frontend's error over at most two windows enters the truth. That error is measured on the
+same run, by the relations whose two scans lie within the window of each other (the mean of
+e e^T of the frontend's relative pose against them, x and y made isotropic; none with fewer than
+10 such relations), and added to the closure's covariance, carried through the composition, for
+each bridge that is not empty (processes/evaluator/loop_closures.hpp does the same in C++). The
+error is the one the pose graph minimises, e = t2v(Z^-1 T_true), and its Mahalanobis distance
+uses the closure's published covariance plus the truth's. Beside it, the error of the frontend's own relative pose between the same two key
 poses, F(from)^-1 F(to), against the same truth: a closure can only straighten the path where it
 is nearer the truth than that. Prints the closures farthest from the truth in sigmas; the last
-line is JSON: closures, checked, median and largest error [m, deg], how many lie over --sigmas
-(default 5) standard deviations, the frontend's median error over the same pairs [m, deg] and in
+line is JSON: closures, checked, median and largest error [m, deg], the median and largest
+Mahalanobis distance (median_sigmas, max_sigmas), how many lie over --sigmas (default 5), the frontend's median error over the same pairs [m, deg] and in
 how many pairs the closure is nearer the truth than the frontend (closure_nearer).
 """
 import argparse
@@ -55,6 +58,33 @@ def det3(m):
     return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
             - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def adjoint(a):
+    """Ad(T) of an SE(2) pose (x, y, theta): moves a twist (vx, vy, w) from T's frame out of it."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return [[c, -s, a[1]], [s, c, -a[0]], [0.0, 0.0, 1.0]]
+
+
+def sandwich(a, m):
+    """A M A^T for 3x3 matrices as lists of rows."""
+    am = [[sum(a[i][k] * m[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    return [[sum(am[i][k] * a[j][k] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def bridge_covariance(pose_near, relations, window_us):
+    """The frontend's error over spans up to window_us, measured by the relations that short."""
+    sums, n = [0.0, 0.0, 0.0], 0
+    for t1, t2, rel in relations:
+        if abs(t2 - t1) > window_us:
+            continue
+        e = compose(inverse(rel), compose(inverse(pose_near(t1)), pose_near(t2)))
+        sums = [sums[0] + e[0] ** 2, sums[1] + e[1] ** 2, sums[2] + e[2] ** 2]
+        n += 1
+    if n < 10:
+        return [[0.0] * 3 for _ in range(3)]
+    xy = 0.5 * (sums[0] + sums[1]) / n
+    return [[xy, 0.0, 0.0], [0.0, xy, 0.0], [0.0, 0.0, sums[2] / n]]
 
 
 def mahalanobis(e, c):
@@ -118,6 +148,7 @@ def main():
 
     relations = read_relations(a.relations)
     window_us = a.window_s * 1e6
+    bridge = bridge_covariance(pose_near, relations, window_us)
     checks = []
     for (from_id, to_id), c in sorted(closures.items()):
         best = None
@@ -133,7 +164,15 @@ def main():
         from_b = compose(inverse(pose_near(tb)), pose_near(c.utime))
         truth = compose(compose(to_a, rel), from_b)
         e = compose(inverse((c.x, c.y, c.theta)), truth)
-        sigmas = mahalanobis(e, list(c.covariance))
+        # T_true = to_a * B, B = rel * from_b: an error d of to_a moves T_true by Ad(B^-1) d in its
+        # own frame, an error of from_b by itself.
+        cov = [[c.covariance[3 * i + j] for j in range(3)] for i in range(3)]
+        for bridged, m in ((ta != c.from_utime, sandwich(adjoint(inverse(compose(rel, from_b))),
+                                                          bridge)),
+                           (tb != c.utime, bridge)):
+            if bridged:
+                cov = [[cov[i][j] + m[i][j] for j in range(3)] for i in range(3)]
+        sigmas = mahalanobis(e, [v for row in cov for v in row])
         f = compose(inverse(compose(inverse(pose_near(c.from_utime)), pose_near(c.utime))), truth)
         checks.append((from_id, to_id, math.hypot(e[0], e[1]), math.degrees(e[2]), sigmas,
                        math.hypot(f[0], f[1]), math.degrees(f[2])))
@@ -143,7 +182,8 @@ def main():
         print(f"  {f} -> {t}: error {err_m:.3f} m, {err_deg:+.2f} deg, {s:.1f} sigmas "
               f"(frontend {fe_m:.3f} m, {fe_deg:+.2f} deg)")
     summary = {"closures": len(closures), "checked": len(checks), "window_s": a.window_s,
-               "sigmas": a.sigmas}
+               "sigmas": a.sigmas, "bridge_sigma_m": round(math.sqrt(bridge[0][0]), 4),
+               "bridge_sigma_deg": round(math.degrees(math.sqrt(bridge[2][2])), 3)}
     if checks:
         summary.update({
             "median_error_m": round(statistics.median(x[2] for x in checks), 4),
@@ -151,6 +191,8 @@ def main():
             "median_error_deg": round(statistics.median(abs(x[3]) for x in checks), 3),
             "max_error_deg": round(max(abs(x[3]) for x in checks), 3),
             "max_sigmas": round(max(x[4] for x in checks), 2),
+            # 1.54 (sqrt of chi-square 3's median) when the covariances are right
+            "median_sigmas": round(statistics.median(x[4] for x in checks), 2),
             "over_sigmas": sum(x[4] > a.sigmas for x in checks),
             "frontend_median_error_m": round(statistics.median(x[5] for x in checks), 4),
             "frontend_median_error_deg": round(statistics.median(abs(x[6]) for x in checks), 3),

@@ -226,10 +226,25 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     // agree with it better (an odometry that slips or a log's restarted odometry must not
     // replace a good frontend step).
     std::optional<OdometryStep> odometry;
+    bool netted = false;
     if (frontend) {
       const auto [ca, cb] = frontend_covariances();
       odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
-      if (odometry && odometry->frontend_rejected) {
+      std::optional<OdometryStep> net;
+      if (odometry && odometry->frontend_rejected && step_before_from_odometry_) {
+        net = spike_net_step(now, *step_before_from_odometry_, ca + cb);
+      }
+      if (net) {
+        // The frontend's last key pose was a spike: its two steps cancel, and their sum agrees
+        // with the odometry. The odometry placed that pose; this step takes the frontend's net.
+        const Pose2& T_world_prev = key_poses_[prev].T_world_base;
+        const MatchResult mn = link_matcher_.match(reference, query, T_world_prev * net->motion);
+        if (mn.valid) m = mn;
+        motion = net->motion;
+        odometry = net;
+        netted = true;
+        ++counters_.frontend_spikes_netted;
+      } else if (odometry && odometry->frontend_rejected) {
         const Pose2& T_world_prev = key_poses_[prev].T_world_base;
         const MatchResult mo =
             link_matcher_.match(reference, query, T_world_prev * odometry->motion);
@@ -287,10 +302,28 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     }
     if (frontend) add_frontend_edges(index, odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
+    // A step netted over a spike is not the start of another.
+    step_before_from_odometry_.reset();
+    if (odometry && !netted) step_before_from_odometry_ = odometry->motion;
   }
   scans_.add(std::move(points));
   key_poses_.push_back(key);
+  key_before_last_ = last_key_;
   last_key_ = now;
+}
+
+std::optional<OdometryStep> Backend::spike_net_step(const PreparedPose& now,
+                                                    const Pose2& step_before,
+                                                    const Eigen::Matrix3d& step_covariance) const {
+  // The frontend's motion over both steps against the odometry's over the same interval, with
+  // both steps' frontend covariances.
+  const Pose2 frontend_net = between(key_before_last_.T_world_base, now.T_world_base);
+  const std::optional<OdometryStep> both =
+      odometry_.compare(key_before_last_.utime, now.utime, frontend_net, 2.0 * step_covariance);
+  if (!both || both->frontend_rejected) return std::nullopt;
+  OdometryStep step = *both;
+  step.motion = step_before.inverse() * frontend_net;
+  return step;
 }
 
 void Backend::add_closure(LoopClosure closure) {

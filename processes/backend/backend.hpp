@@ -203,6 +203,9 @@ struct BackendCounters {
   // Frontend steps the odometry contradicted and the scans matched better at the odometry's
   // (odometry_check.hpp): replaced by the odometry's.
   long frontend_steps_replaced = 0;
+  // ... where the next step was contradicted too and the frontend's motion over both agreed with
+  // the odometry's (a spike at one key pose): that step took the frontend's net motion over both.
+  long frontend_spikes_netted = 0;
   long closures_rejected_inconsistent = 0;  // closures the trial optimisation refused
   long optimisations = 0;
   long optimisations_failed = 0;      // not converged or covariance not recovered
@@ -277,6 +280,13 @@ class Backend {
   // Adds the frontend's edges of the new key pose `key` (frontend_chain.hpp); `odometry`: the
   // odometry's step when it rejected the frontend's, which then takes its place.
   void add_frontend_edges(int key, const std::optional<OdometryStep>& odometry);
+  // After the odometry replaced the last key step (`step_before`) and contradicts this one too:
+  // the frontend's net motion over both, as this step's (step_before^-1 * net), when that net
+  // agrees with the odometry's over the same interval; nullopt otherwise. A frontend that places
+  // one key pose off and the next back (a spike) keeps its net motion; a frontend that slipped
+  // stays replaced.
+  std::optional<OdometryStep> spike_net_step(const PreparedPose& now, const Pose2& step_before,
+                                             const Eigen::Matrix3d& step_covariance) const;
   // Adds the closure unless a trial optimisation finds it inconsistent with the graph.
   void add_closure(LoopClosure closure);
   std::optional<BackendUpdate> optimise();
@@ -302,7 +312,10 @@ class Backend {
   std::vector<EdgeKind> edge_kinds_;  // parallel to graph_.edges
   std::vector<KeyEdge> key_edges_;
   std::vector<KeyPose> key_poses_;
-  PreparedPose last_key_;  // prepared pose of the last key pose
+  PreparedPose last_key_;          // prepared pose of the last key pose
+  PreparedPose key_before_last_;   // ... and of the one before it
+  // The odometry's motion over the last key step, where it replaced the frontend's.
+  std::optional<Pose2> step_before_from_odometry_;
   ScanStore scans_;
   std::vector<LoopClosure> closures_;
   int first_unreported_key_ = 0;

@@ -275,6 +275,7 @@ void BackendNode::report_counters() {
   counters_("odometry_steps_checked", static_cast<double>(o.steps_checked));
   counters_("odometry_steps_contradicted", static_cast<double>(o.steps_contradicted));
   counters_("frontend_steps_replaced_by_odometry", static_cast<double>(c.frontend_steps_replaced));
+  counters_("frontend_spikes_netted", static_cast<double>(c.frontend_spikes_netted));
   counters_("loop_closures", static_cast<double>(backend_.closures().size()));
   counters_("loop_episodes", static_cast<double>(l.episodes));
   counters_("loop_candidates", static_cast<double>(l.candidates));

@@ -86,16 +86,23 @@ std::optional<Pose2> OdometryCheck::at(int64_t utime) const {
 std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utime,
                                                  const Pose2& frontend_motion,
                                                  const Eigen::Matrix3d& frontend_covariance) {
-  if (!config_.enabled) return std::nullopt;
-  const std::optional<Pose2> a = at(a_utime), b = at(b_utime);
-  if (!a || !b) return std::nullopt;
-  const auto near = std::lower_bound(implausible_.begin(), implausible_.end(),
-                                     a_utime - config_.max_reading_gap_us);
-  if (near != implausible_.end() && *near <= b_utime + config_.max_reading_gap_us) {
+  if (!config_.enabled || !at(a_utime) || !at(b_utime)) return std::nullopt;
+  if (implausible_near(a_utime, b_utime)) {
     ++counters_.steps_implausible;
     return std::nullopt;
   }
   ++counters_.steps_checked;
+  std::optional<OdometryStep> step = compare(a_utime, b_utime, frontend_motion, frontend_covariance);
+  if (step && step->frontend_rejected) ++counters_.steps_contradicted;
+  return step;
+}
+
+std::optional<OdometryStep> OdometryCheck::compare(int64_t a_utime, int64_t b_utime,
+                                                   const Pose2& frontend_motion,
+                                                   const Eigen::Matrix3d& frontend_covariance) const {
+  if (!config_.enabled) return std::nullopt;
+  const std::optional<Pose2> a = at(a_utime), b = at(b_utime);
+  if (!a || !b || implausible_near(a_utime, b_utime)) return std::nullopt;
   OdometryStep step;
   step.motion = between(*a, *b);
   const double d = step.motion.translation().norm();
@@ -106,8 +113,13 @@ std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utim
   step.frontend_chi2 =
       step_chi2(frontend_motion, step.motion, step.covariance + frontend_covariance);
   step.frontend_rejected = !(step.frontend_chi2 <= config_.max_frontend_chi2);
-  if (step.frontend_rejected) ++counters_.steps_contradicted;
   return step;
+}
+
+bool OdometryCheck::implausible_near(int64_t a_utime, int64_t b_utime) const {
+  const auto near = std::lower_bound(implausible_.begin(), implausible_.end(),
+                                     a_utime - config_.max_reading_gap_us);
+  return near != implausible_.end() && *near <= b_utime + config_.max_reading_gap_us;
 }
 
 }  // namespace traverse::backend

@@ -113,11 +113,17 @@ class OdometryCheck {
   // the frame of a (zero: the odometry's model alone decides).
   std::optional<OdometryStep> check(int64_t a_utime, int64_t b_utime, const Pose2& frontend_motion,
                                     const Eigen::Matrix3d& frontend_covariance);
+  // The same comparison, not counted: a second look over steps already checked.
+  std::optional<OdometryStep> compare(int64_t a_utime, int64_t b_utime,
+                                      const Pose2& frontend_motion,
+                                      const Eigen::Matrix3d& frontend_covariance) const;
 
   const OdometryCounters& counters() const { return counters_; }
 
  private:
   std::optional<Pose2> at(int64_t utime) const;
+  // An implausible reading within max_reading_gap_us of the interval [a, b].
+  bool implausible_near(int64_t a_utime, int64_t b_utime) const;
 
   OdometryCheckConfig config_;
   OdometryCounters counters_;

@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <iterator>
 
 namespace traverse::evaluator {
 
@@ -30,12 +32,17 @@ std::optional<double> mahalanobis(const Eigen::Vector3d& e, const Eigen::Matrix3
   return w.norm();
 }
 
-}  // namespace
+// The truth of one closure: T_true, and the covariance of T_true's own error (right-perturbation
+// in T_true's frame; zero for a reference taken as exact).
+struct Truth {
+  Pose2 T_true;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
 
-ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Trajectory reference,
-                                 const MatchConfig& match, double false_sigmas) {
-  sort_unique(reference);
-  const ReferenceInterpolator interpolator(reference, match);
+// The check against any source of truth: `truth` gives a closure's Truth, or nullopt.
+template <class TruthOf>
+ClosureEvaluation check_against(const std::vector<LoopClosure>& closures, const TruthOf& truth_of,
+                                double false_sigmas) {
   ClosureEvaluation ev;
   ev.closures = closures.size();
   double sum_sq_m2 = 0.0;
@@ -44,15 +51,14 @@ ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Traje
     ClosureCheck check;
     check.closure = c;
     check.sigma = c.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-    const auto from = interpolator.at(c.from_utime);
-    const auto to = interpolator.at(c.to_utime);
-    if (!from || !to) {
+    const std::optional<Truth> truth = truth_of(c);
+    if (!truth) {
       ++ev.unmatched;
       ev.checks.push_back(check);
       continue;
     }
     check.matched = true;
-    check.T_true = between(from->pose, to->pose);
+    check.T_true = truth->T_true;
     // e = t2v(Z^-1 T_true): between() gives the translation in Z's frame; the angle is wrapped.
     const Pose2 E = between(c.T_from_to, check.T_true);
     check.error = Eigen::Vector3d(E.x(), E.y(), wrap_angle(E.theta()));
@@ -60,7 +66,7 @@ ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Traje
     ++matched;
     sum_sq_m2 += error_m * error_m;
     ev.max_error_m = std::max(ev.max_error_m.value_or(0.0), error_m);
-    check.mahalanobis = mahalanobis(check.error, c.covariance);
+    check.mahalanobis = mahalanobis(check.error, c.covariance + truth->covariance);
     if (!check.mahalanobis) {
       ++ev.bad_covariance;
     } else {
@@ -72,6 +78,97 @@ ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Traje
   }
   if (matched > 0) ev.rms_error_m = std::sqrt(sum_sq_m2 / static_cast<double>(matched));
   return ev;
+}
+
+// The pose of `trajectory` (sorted, not empty) nearest `utime`.
+const Pose2& nearest(const Trajectory& trajectory, int64_t utime) {
+  auto it = std::lower_bound(trajectory.begin(), trajectory.end(), utime,
+                             [](const StampedPose& p, int64_t t) { return p.utime < t; });
+  if (it == trajectory.end()) return trajectory.back().pose;
+  if (it != trajectory.begin() && utime - std::prev(it)->utime < it->utime - utime) --it;
+  return it->pose;
+}
+
+// The frontend's error over a bridge: the mean of e e^T over the relations whose scans lie within
+// `window_us` of each other, e = t2v(R^-1 F(t1)^-1 F(t2)), made isotropic in x and y (a bridge
+// is used in any heading). Zero with fewer than 10 such relations: the truth is then taken as
+// exact.
+Eigen::Matrix3d bridge_covariance(const Trajectory& frontend, const std::vector<Relation>& relations,
+                                  int64_t window_us) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (const Relation& r : relations) {
+    if (std::abs(r.t2_utime - r.t1_utime) > window_us) continue;
+    const Pose2 F = between(nearest(frontend, r.t1_utime), nearest(frontend, r.t2_utime));
+    const Pose2 E = between(r.T_1_2, F);
+    const Eigen::Vector3d e(E.x(), E.y(), wrap_angle(E.theta()));
+    sum += e * e.transpose();
+    ++n;
+  }
+  if (n < 10) return Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d mean = sum / n;
+  Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+  c(0, 0) = c(1, 1) = 0.5 * (mean(0, 0) + mean(1, 1));
+  c(2, 2) = mean(2, 2);
+  return c;
+}
+
+}  // namespace
+
+ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Trajectory reference,
+                                 const MatchConfig& match, double false_sigmas) {
+  sort_unique(reference);
+  const ReferenceInterpolator interpolator(reference, match);
+  return check_against(
+      closures,
+      [&](const LoopClosure& c) -> std::optional<Truth> {
+        const auto from = interpolator.at(c.from_utime);
+        const auto to = interpolator.at(c.to_utime);
+        if (!from || !to) return std::nullopt;
+        return Truth{between(from->pose, to->pose)};
+      },
+      false_sigmas);
+}
+
+ClosureEvaluation check_closures_by_relations(const std::vector<LoopClosure>& closures,
+                                              Trajectory frontend,
+                                              const std::vector<Relation>& relations,
+                                              int64_t window_us, double false_sigmas) {
+  sort_unique(frontend);
+  const Eigen::Matrix3d bridge =
+      frontend.empty() ? Eigen::Matrix3d::Zero() : bridge_covariance(frontend, relations, window_us);
+  return check_against(
+      closures,
+      [&](const LoopClosure& c) -> std::optional<Truth> {
+        if (frontend.empty()) return std::nullopt;
+        // The relation whose ends lie nearest the two key poses (summed), either way round.
+        std::optional<int64_t> best_us;
+        int64_t ta = 0, tb = 0;
+        Pose2 R;
+        for (const Relation& r : relations) {
+          for (const bool reversed : {false, true}) {
+            const int64_t a = reversed ? r.t2_utime : r.t1_utime;
+            const int64_t b = reversed ? r.t1_utime : r.t2_utime;
+            const int64_t da = std::abs(a - c.from_utime), db = std::abs(b - c.to_utime);
+            if (da > window_us || db > window_us || (best_us && da + db >= *best_us)) continue;
+            best_us = da + db;
+            ta = a;
+            tb = b;
+            R = reversed ? r.T_1_2.inverse() : r.T_1_2;
+          }
+        }
+        if (!best_us) return std::nullopt;
+        const Pose2 to_a = between(nearest(frontend, c.from_utime), nearest(frontend, ta));
+        const Pose2 from_b = between(nearest(frontend, tb), nearest(frontend, c.to_utime));
+        // T_true = to_a * B, B = R * from_b. An error of to_a (right-perturbation d) moves T_true
+        // by Ad(B^-1) d in its own frame; an error of from_b by itself.
+        Truth truth{to_a * R * from_b};
+        const Eigen::Matrix3d Ad = (R * from_b).inverse().adjoint();
+        if (ta != c.from_utime) truth.covariance += Ad * bridge * Ad.transpose();
+        if (tb != c.to_utime) truth.covariance += bridge;
+        return truth;
+      },
+      false_sigmas);
 }
 
 }  // namespace traverse::evaluator

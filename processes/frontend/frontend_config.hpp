@@ -73,9 +73,10 @@ struct MatcherConfig {
   // probability all around, at the predicted pose, are left out of the match and the map
   // (hector/moved_points.hpp: people walking through, mixed pixels). 0 keeps every point. 0.25
   // with the two keys above (0.03, true) wins on every simulated route with odometry (metres on
-  // corridor-return, office-s2, office-s3) but loses the relations log aces on 2 of 4 starts a
-  // centimetre or a milliradian apart (0.21, 0.32 m against 0.039-0.045 m off), and the
-  // regression log's RMSE is 5 % worse: off (docs/frontends.md, "The spread").
+  // corridor-return, office-s2, office-s3); on the relations log aces it lost 2 of 4 starts a
+  // centimetre or a milliradian apart until the odometry check counted only what the scan
+  // determines (now 0.040-0.045 m from 5 starts against 0.039-0.041 m off), and the regression
+  // log's RMSE was 5 % worse: off (docs/frontends.md, "The spread").
   double moved_max_probability = 0.0;
   // Recovery: when the RMS of 1 - M after Gauss-Newton exceeds this, the prediction was too far
   // off for gradient steps (a fast turn between sparse scans): search exhaustively on the
@@ -271,8 +272,9 @@ struct MotionPriorConfig {
   // if its residual is lower by more than this (or it passes the unverified check that the other
   // fails) and the two poses lie more than odometry_check_sigmas apart by the covariance of the
   // match with odometry (the scan tells them apart: along a corridor's axis it does not, and the
-  // map made at the last pose would favour standing still), counted odometry_overruled. 0
-  // trusts odometry always.
+  // map made at the last pose would favour standing still; with MatcherConfig::
+  // degeneracy_min_ratio only the difference along the directions the scan determines at one of
+  // the two poses counts), counted odometry_overruled. 0 trusts odometry always.
   double odometry_check_margin = 0.005;
   double odometry_check_sigmas = 3.0;
   // Use odometry on a log subsampled by travel (MatcherConfig::wide_search_gap_us: the median of

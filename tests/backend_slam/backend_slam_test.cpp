@@ -253,6 +253,51 @@ TEST(Backend, OdometryReplacesAFrontendStepItContradicts) {
   EXPECT_LT(error_with, 0.05);    // [m]
 }
 
+// A frontend whose pose is off by 0.4 m for a few scans around one key pose and right again after
+// (Kummerle's fr079 at 2109.7 s: 0.436 m forward, 0.261 m back), while the wheels slip by 5 cm
+// over the same interval. The odometry contradicts both key steps around the spike. It places the
+// spike's key pose; the step after takes the frontend's net motion over both, which agrees with
+// the odometry's, so the slip stays out. Before, the odometry replaced both steps and its slip
+// moved the rest of the run by 5 cm.
+TEST(Backend, OdometryOverAFrontendSpikeKeepsTheFrontendsNetMotion) {
+  test::Drive d = test::drive_ellipse(8.0);
+  const std::size_t spike_begin = 40, spike_end = 44;  // 0.4 s: one key pose's scan among them
+  d.input = d.truth;
+  for (std::size_t k = spike_begin; k < spike_end; ++k) d.input[k] = d.truth[k] * Pose2(0.4, 0, 0);
+  const Eigen::Matrix3d covariance = Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal();
+  BackendConfig config;
+  config.smoothing.input = "sparse";  // no jump smoothing: the spike reaches the graph
+  // The frontend's chain and the odometry alone (no link edges, no closures), so that what the
+  // graph makes of the two steps is all that moves the rest of the run.
+  config.min_link_response = 1.0;
+  config.loop.min_travel_m = 1e5;
+  Backend backend(config);
+  for (std::size_t k = 0; k < d.utimes.size(); ++k) {
+    // The odometry is the truth, slipped 5 cm back over the spike's scans and after.
+    const double slip = k < spike_begin ? 0.0 : -0.05 * std::min(1.0, (k - spike_begin) / 4.0);
+    backend.add_odometry(d.utimes[k], d.truth[k] * Pose2(slip, 0.0, 0.0));
+    backend.add_scan(d.scans[k]);
+    backend.add_pose(d.utimes[k], d.input[k], covariance);
+  }
+  backend.finish();
+  EXPECT_EQ(backend.counters().frontend_steps_replaced, 1);
+  EXPECT_EQ(backend.counters().frontend_spikes_netted, 1);
+  // The key poses after the spike where the frontend put them: within 1 cm of the truth (with
+  // both steps replaced, 4-5 cm off).
+  double largest_after_m = 0.0;
+  for (const KeyPose& key : backend.key_poses()) {
+    const std::size_t k = static_cast<std::size_t>(
+        std::find(d.utimes.begin(), d.utimes.end(), key.utime) - d.utimes.begin());
+    ASSERT_LT(k, d.utimes.size());
+    if (k < spike_end) continue;
+    largest_after_m = std::max(
+        largest_after_m, (key.T_world_base.translation() - d.truth[k].translation()).norm());
+  }
+  std::printf("key poses after the spike against the truth: largest error %.4f m\n",
+              largest_after_m);
+  EXPECT_LT(largest_after_m, 0.01);
+}
+
 // Odometry whose readings lag (Kummerle's intel: ODOM stamps in bursts) contradicts a right
 // frontend step by 0.15 m; the link matched around the odometry's step ends where the one around
 // the frontend's did, with a response higher by the grid's luck. Before, that response alone

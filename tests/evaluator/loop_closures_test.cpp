@@ -117,6 +117,124 @@ TEST(LoopClosures, CovarianceThatIsNotPositiveDefiniteIsReported) {
   EXPECT_NEAR(*ev.max_error_m, 1.0, 1e-9);
 }
 
+// A frontend that slips once, at 10 s, by 0.3 m and 0.05 rad: its relative pose across the slip
+// is wrong, but within 2 s of any time away from it it moves as the truth does.
+Trajectory slipping_frontend() {
+  return test::sample(
+      [](double t_s) {
+        const Pose2 slip = t_s < 10.0 ? Pose2() : Pose2(0.3, -0.1, 0.05);
+        return slip * circle_pose(t_s);
+      },
+      1'000'000, 100'000, 191);  // 10 Hz, 1-20 s
+}
+
+// The truth between scans at `t1_us` and `t2_us`, as a relations file would hold it.
+Relation relation(int64_t t1_us, int64_t t2_us) {
+  Relation r;
+  r.t1_utime = t1_us;
+  r.t2_utime = t2_us;
+  r.T_1_2 = between(circle_pose(1e-6 * static_cast<double>(t1_us)),
+                    circle_pose(1e-6 * static_cast<double>(t2_us)));
+  return r;
+}
+
+TEST(LoopClosuresByRelations, TheTruthIsBridgedByTheFrontendOnlyNearTheKeyPoses) {
+  // Key poses at 3 s and 16 s; the relation's scans 0.6 s and 1.2 s from them: the frontend's
+  // slip between them (0.3 m) stays out of the truth.
+  const std::vector<Relation> relations = {relation(3'600'000, 14'800'000)};
+  const std::vector<LoopClosure> closures = {
+      closure(1, 40, 3'000'000, 16'000'000),                                // exact
+      closure(2, 41, 3'000'000, 16'000'000, Pose2(6 * kSigmaXM, 0.0, 0.0)),  // 6 sigmas off
+  };
+  const ClosureEvaluation ev =
+      check_closures_by_relations(closures, slipping_frontend(), relations, 2'000'000, kFive);
+  ASSERT_EQ(ev.checks.size(), 2u);
+  EXPECT_EQ(ev.unmatched, 0u);
+  EXPECT_NEAR(ev.checks[0].mahalanobis.value(), 0.0, 1e-6);
+  EXPECT_FALSE(ev.checks[0].is_false);
+  EXPECT_NEAR(ev.checks[1].mahalanobis.value(), 6.0, 1e-6);
+  EXPECT_TRUE(ev.checks[1].is_false);
+  EXPECT_EQ(ev.false_closures, 1u);
+  // The frontend's own relative pose between the key poses carries the slip: a closure equal to
+  // it is false by the relation.
+  LoopClosure like_frontend = closures[0];
+  const Trajectory f = slipping_frontend();
+  like_frontend.T_from_to = between(f[20].pose, f[150].pose);  // 3 s and 16 s
+  const ClosureEvaluation slipped =
+      check_closures_by_relations({like_frontend}, f, relations, 2'000'000, kFive);
+  EXPECT_TRUE(slipped.checks[0].is_false);
+}
+
+TEST(LoopClosuresByRelations, ARelationIsUsedEitherWayRoundAndTheNearestWins) {
+  const std::vector<Relation> relations = {
+      relation(15'000'000, 4'500'000),  // reversed: its t2 near the older key pose; 2.5 s away
+      relation(15'500'000, 3'200'000),  // reversed, 0.7 s away in all: the one used
+  };
+  ClosureEvaluation ev = check_closures_by_relations({closure(1, 40, 3'000'000, 16'000'000)},
+                                                     slipping_frontend(), relations, 2'000'000,
+                                                     kFive);
+  ASSERT_EQ(ev.checks.size(), 1u);
+  ASSERT_TRUE(ev.checks[0].matched);
+  EXPECT_NEAR(*ev.max_error_m, 0.0, 1e-9);
+  // A relation that is itself wrong moves the truth: the wrong one is not used when a nearer one
+  // exists, and is used when it is the only one in the window.
+  std::vector<Relation> with_wrong = relations;
+  with_wrong.push_back(relation(3'900'000, 15'900'000));
+  with_wrong.back().T_1_2 = with_wrong.back().T_1_2 * Pose2(0.2, 0.0, 0.0);  // 0.9 + 0.1 s away
+  ev = check_closures_by_relations({closure(1, 40, 3'000'000, 16'000'000)}, slipping_frontend(),
+                                   with_wrong, 2'000'000, kFive);
+  EXPECT_NEAR(*ev.max_error_m, 0.0, 1e-9);
+  ev = check_closures_by_relations({closure(1, 40, 3'000'000, 16'000'000)}, slipping_frontend(),
+                                   {with_wrong.back()}, 2'000'000, kFive);
+  EXPECT_NEAR(*ev.max_error_m, 0.2, 1e-9);
+}
+
+TEST(LoopClosuresByRelations, AClosureNoRelationReachesIsUnmatched) {
+  const std::vector<Relation> relations = {relation(3'000'000, 12'000'000)};  // 4 s from `to`
+  const ClosureEvaluation ev = check_closures_by_relations(
+      {closure(1, 40, 3'000'000, 16'000'000)}, slipping_frontend(), relations, 2'000'000, kFive);
+  EXPECT_EQ(ev.unmatched, 1u);
+  EXPECT_FALSE(ev.checks[0].matched);
+  EXPECT_FALSE(ev.max_error_m);
+  const ClosureEvaluation no_frontend =
+      check_closures_by_relations({closure(1, 40, 3'000'000, 12'000'000)}, {}, relations,
+                                  2'000'000, kFive);
+  EXPECT_EQ(no_frontend.unmatched, 1u);
+}
+
+TEST(LoopClosuresByRelations, TheFrontendsErrorOverShortSpansWidensTheTruthsCovariance) {
+  // A frontend whose heading alternates +-0.01 rad about the truth from sample to sample: over
+  // 0.1 s it errs by 0.02 rad, which 30 relations between neighbouring samples measure.
+  const Trajectory wobbling = test::sample(
+      [](double t_s) {
+        const int i = static_cast<int>(std::lround((t_s - 1.0) * 10.0));
+        return circle_pose(t_s) * Pose2(0.0, 0.0, i % 2 == 0 ? 0.01 : -0.01);
+      },
+      1'000'000, 100'000, 191);
+  std::vector<Relation> relations;
+  for (int i = 0; i < 30; ++i) {
+    relations.push_back(relation(1'000'000 + i * 100'000, 1'100'000 + i * 100'000));
+  }
+  // The closure's from-end on the relation's scan (no bridge); its to-end 1.2 s (12 samples, the
+  // same sign) after the relation's other scan: one bridge, exact here, of variance 0.02^2 rad^2.
+  relations.push_back(relation(3'000'000, 14'800'000));
+  const LoopClosure c = closure(1, 40, 3'000'000, 16'000'000, Pose2(0.0, 0.0, 6 * kSigmaThetaRad));
+  const ClosureEvaluation ev =
+      check_closures_by_relations({c}, wobbling, relations, 2'000'000, kFive);
+  ASSERT_TRUE(ev.checks[0].matched);
+  EXPECT_NEAR(ev.checks[0].error.z(), 6 * kSigmaThetaRad, 1e-9);
+  const double expected = 6 * kSigmaThetaRad / std::hypot(kSigmaThetaRad, 0.02);
+  // (The bridge turns its translation by the wobble, 5 mm against sigmas of 1-2 cm: 3 %.)
+  EXPECT_NEAR(ev.checks[0].mahalanobis.value(), expected, 0.03 * expected);
+  EXPECT_FALSE(ev.checks[0].is_false);
+  // Without the short relations the same closure is six sigmas off.
+  relations.erase(relations.begin(), relations.begin() + 30);
+  const ClosureEvaluation alone =
+      check_closures_by_relations({c}, wobbling, relations, 2'000'000, kFive);
+  EXPECT_NEAR(alone.checks[0].mahalanobis.value(), 6.0, 0.01);
+  EXPECT_TRUE(alone.checks[0].is_false);
+}
+
 TEST(LoopClosureSet, RepeatedClosureIsKeptOnce) {
   LoopClosureSet set;
   set.add(closure(1, 2, 2'000'000, 6'000'000, Pose2(1.0, 0.0, 0.0)));

@@ -120,7 +120,8 @@ Measurement HectorFrontend::measure(const Scan& scan) {
       if (differ(with.T_map_base, without.T_map_base)) {
         Attempt other = match_from(m, without);
         if (better(other, attempt, config_.motion_prior.odometry_check_margin) &&
-            apart(other, attempt, config_.motion_prior.odometry_check_sigmas)) {
+            apart(other, attempt, determined(attempt.match, m.points_matched),
+                  config_.motion_prior.odometry_check_sigmas)) {
           ++counters_.odometry_overruled;
           attempt = std::move(other);
         }
@@ -194,11 +195,27 @@ void HectorFrontend::drop_moved(std::vector<Eigen::Vector2d>& points_base,
   counters_.points_moved += static_cast<int64_t>(n);
 }
 
+Degeneracy HectorFrontend::degeneracy(const Eigen::Matrix3d& information,
+                                      const std::vector<Eigen::Vector2d>& points_matched) const {
+  return analyse_degeneracy(information, points_rms_range_m(points_matched),
+                            std::max(config_.matcher.degeneracy_min_ratio, 1e-12));
+}
+
+Eigen::Matrix3d HectorFrontend::determined(
+    const MatchResult& match, const std::vector<Eigen::Vector2d>& points_matched) const {
+  if (config_.matcher.degeneracy_min_ratio <= 0.0) return Eigen::Matrix3d::Identity();
+  const Degeneracy dg = degeneracy(match.information, points_matched);
+  // A match that determines no direction at all has no surface under its points: the prediction
+  // put the scan where the map knows nothing (intel: odometry jumps 5.5 m in one step), which says
+  // the pose is wrong, not that the scan cannot tell.
+  if (dg.directions == 3) return Eigen::Matrix3d::Identity();
+  return dg.projector;
+}
+
 void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match,
                                      const std::vector<Eigen::Vector2d>& points_matched,
                                      const MotionModel::Prediction& prediction) {
-  const Degeneracy dg = analyse_degeneracy(match.information, points_rms_range_m(points_matched),
-                                           std::max(config_.matcher.degeneracy_min_ratio, 1e-12));
+  const Degeneracy dg = degeneracy(match.information, points_matched);
   r.diagnostics->degeneracy_ratio = dg.ratio;
   if (config_.matcher.degeneracy_min_ratio <= 0.0 || dg.directions == 0) return;
   ++counters_.scans_degenerate;
@@ -221,8 +238,15 @@ bool HectorFrontend::better(const Attempt& a, const Attempt& b, double margin) {
   return a.match.residual_rms + margin < b.match.residual_rms;
 }
 
-bool HectorFrontend::apart(const Attempt& a, const Attempt& b, double sigmas) {
-  const Eigen::Vector3d d = between(b.match.T_map_base, a.match.T_map_base).log();
+bool HectorFrontend::apart(const Attempt& a, const Attempt& b, const Eigen::Matrix3d& determined,
+                           double sigmas) {
+  // In the map frame, as the covariance is; only the part the scan determines counts: along a
+  // direction it leaves open (a corridor's axis) the two matches differ by where each started
+  // and by the map's history there, which the residuals favour (the map was made at the last
+  // pose), and the scan would overrule odometry with that, scan after scan, into a slide.
+  Eigen::Vector3d d = a.match.T_map_base.vector() - b.match.T_map_base.vector();
+  d.z() = wrap_angle(d.z());
+  d = determined * d;
   const Eigen::Matrix3d& C = b.match.covariance;
   if (C.determinant() <= 0.0) return true;
   return d.dot(C.ldlt().solve(d)) > sigmas * sigmas;

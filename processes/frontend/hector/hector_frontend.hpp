@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "degeneracy.hpp"
 #include "frontend_config.hpp"
 #include "map_pyramid.hpp"
 #include "motion_model.hpp"
@@ -112,8 +113,17 @@ class HectorFrontend final : public TwoPhaseFrontend {
   bool differ(const Pose2& a, const Pose2& b) const;
   // a fits better than b: verified where b is not, else a residual lower by more than margin.
   static bool better(const Attempt& a, const Attempt& b, double margin);
-  // a's pose lies more than `sigmas` standard deviations of b's covariance from b's.
-  static bool apart(const Attempt& a, const Attempt& b, double sigmas);
+  // a's pose lies more than `sigmas` standard deviations of b's covariance from b's, counting
+  // only the difference along the directions `determined` projects onto (map frame).
+  static bool apart(const Attempt& a, const Attempt& b, const Eigen::Matrix3d& determined,
+                    double sigmas);
+  // The degenerate directions of a match's information (degeneracy.hpp), and the projector onto
+  // the directions the match determines (the identity with MatcherConfig::degeneracy_min_ratio
+  // off, or when it determines none: its points fell where the map knows nothing).
+  Degeneracy degeneracy(const Eigen::Matrix3d& information,
+                        const std::vector<Eigen::Vector2d>& points_matched) const;
+  Eigen::Matrix3d determined(const MatchResult& match,
+                             const std::vector<Eigen::Vector2d>& points_matched) const;
   void count_odometry(const MotionModel::Prediction& prediction);
   // The matcher's config for a prediction: the searches' windows sized by its odometry step;
   // normal projection only with odometry.
