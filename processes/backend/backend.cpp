@@ -234,10 +234,10 @@ void Backend::add_key_pose(const PlanarScan& scan) {
       if (odometry && odometry->frontend_rejected && step_before_from_odometry_) {
         net = spike_net_step(now, *step_before_from_odometry_, ca + cb);
       }
+      const Pose2& T_world_prev = key_poses_[prev].T_world_base;
       if (net) {
         // The frontend's last key pose was a spike: its two steps cancel, and their sum agrees
         // with the odometry. The odometry placed that pose; this step takes the frontend's net.
-        const Pose2& T_world_prev = key_poses_[prev].T_world_base;
         const MatchResult mn = link_matcher_.match(reference, query, T_world_prev * net->motion);
         if (mn.valid) m = mn;
         motion = net->motion;
@@ -245,7 +245,6 @@ void Backend::add_key_pose(const PlanarScan& scan) {
         netted = true;
         ++counters_.frontend_spikes_netted;
       } else if (odometry && odometry->frontend_rejected) {
-        const Pose2& T_world_prev = key_poses_[prev].T_world_base;
         const MatchResult mo =
             link_matcher_.match(reference, query, T_world_prev * odometry->motion);
         if (mo.valid && scans_side_with_odometry(

@@ -86,14 +86,16 @@ std::optional<Pose2> OdometryCheck::at(int64_t utime) const {
 std::optional<OdometryStep> OdometryCheck::check(int64_t a_utime, int64_t b_utime,
                                                  const Pose2& frontend_motion,
                                                  const Eigen::Matrix3d& frontend_covariance) {
-  if (!config_.enabled || !at(a_utime) || !at(b_utime)) return std::nullopt;
+  if (!config_.enabled) return std::nullopt;
+  const std::optional<Pose2> a = at(a_utime), b = at(b_utime);
+  if (!a || !b) return std::nullopt;
   if (implausible_near(a_utime, b_utime)) {
     ++counters_.steps_implausible;
     return std::nullopt;
   }
   ++counters_.steps_checked;
-  std::optional<OdometryStep> step = compare(a_utime, b_utime, frontend_motion, frontend_covariance);
-  if (step && step->frontend_rejected) ++counters_.steps_contradicted;
+  OdometryStep step = judge(*a, *b, frontend_motion, frontend_covariance);
+  if (step.frontend_rejected) ++counters_.steps_contradicted;
   return step;
 }
 
@@ -103,8 +105,13 @@ std::optional<OdometryStep> OdometryCheck::compare(int64_t a_utime, int64_t b_ut
   if (!config_.enabled) return std::nullopt;
   const std::optional<Pose2> a = at(a_utime), b = at(b_utime);
   if (!a || !b || implausible_near(a_utime, b_utime)) return std::nullopt;
+  return judge(*a, *b, frontend_motion, frontend_covariance);
+}
+
+OdometryStep OdometryCheck::judge(const Pose2& a, const Pose2& b, const Pose2& frontend_motion,
+                                  const Eigen::Matrix3d& frontend_covariance) const {
   OdometryStep step;
-  step.motion = between(*a, *b);
+  step.motion = between(a, b);
   const double d = step.motion.translation().norm();
   const double sxy = config_.min_sigma_xy_m + config_.sigma_xy_per_m * d;
   const double sth = config_.min_sigma_theta_rad + config_.sigma_theta_per_m * d +

@@ -124,6 +124,9 @@ class OdometryCheck {
   std::optional<Pose2> at(int64_t utime) const;
   // An implausible reading within max_reading_gap_us of the interval [a, b].
   bool implausible_near(int64_t a_utime, int64_t b_utime) const;
+  // The odometry's step from pose a to pose b (its error model) against the frontend's.
+  OdometryStep judge(const Pose2& a, const Pose2& b, const Pose2& frontend_motion,
+                     const Eigen::Matrix3d& frontend_covariance) const;
 
   OdometryCheckConfig config_;
   OdometryCounters counters_;

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <iterator>
+#include <limits>
 
 namespace traverse::evaluator {
 
@@ -80,13 +80,9 @@ ClosureEvaluation check_against(const std::vector<LoopClosure>& closures, const 
   return ev;
 }
 
-// The pose of `trajectory` (sorted, not empty) nearest `utime`.
+// The pose of `trajectory` (sorted, not empty) nearest `utime`, however far.
 const Pose2& nearest(const Trajectory& trajectory, int64_t utime) {
-  auto it = std::lower_bound(trajectory.begin(), trajectory.end(), utime,
-                             [](const StampedPose& p, int64_t t) { return p.utime < t; });
-  if (it == trajectory.end()) return trajectory.back().pose;
-  if (it != trajectory.begin() && utime - std::prev(it)->utime < it->utime - utime) --it;
-  return it->pose;
+  return pose_at(trajectory, utime, std::numeric_limits<int64_t>::max())->pose;
 }
 
 // The frontend's error over a bridge: the mean of e e^T over the relations whose scans lie within

@@ -39,19 +39,6 @@ std::optional<Relation> parse_relation(const std::string& line) {
   return r;
 }
 
-// The pose nearest `utime` within the tolerance, if any; `estimate` sorted by time.
-const StampedPose* pose_at(const Trajectory& estimate, int64_t utime, int64_t tolerance_us) {
-  const auto it = std::lower_bound(estimate.begin(), estimate.end(), utime,
-                                   [](const StampedPose& p, int64_t t) { return p.utime < t; });
-  const StampedPose* best = nullptr;
-  if (it != estimate.end()) best = &*it;
-  if (it != estimate.begin() && (!best || utime - std::prev(it)->utime < best->utime - utime)) {
-    best = &*std::prev(it);
-  }
-  if (!best || std::abs(best->utime - utime) > tolerance_us) return nullptr;
-  return best;
-}
-
 }  // namespace
 
 RelationsFile read_relations(const std::string& path) {

@@ -1,6 +1,8 @@
 #include "trajectory.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <iterator>
 
 namespace traverse::evaluator {
 
@@ -11,6 +13,18 @@ void sort_unique(Trajectory& trajectory) {
       std::unique(trajectory.begin(), trajectory.end(),
                   [](const StampedPose& a, const StampedPose& b) { return a.utime == b.utime; }),
       trajectory.end());
+}
+
+const StampedPose* pose_at(const Trajectory& trajectory, int64_t utime, int64_t tolerance_us) {
+  const auto it = std::lower_bound(trajectory.begin(), trajectory.end(), utime,
+                                   [](const StampedPose& p, int64_t t) { return p.utime < t; });
+  const StampedPose* best = nullptr;
+  if (it != trajectory.end()) best = &*it;
+  if (it != trajectory.begin() && (!best || utime - std::prev(it)->utime < best->utime - utime)) {
+    best = &*std::prev(it);
+  }
+  if (!best || std::abs(best->utime - utime) > tolerance_us) return nullptr;
+  return best;
 }
 
 ReferenceInterpolator::ReferenceInterpolator(const Trajectory& reference, MatchConfig config)

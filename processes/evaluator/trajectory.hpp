@@ -27,6 +27,9 @@ using Trajectory = std::vector<StampedPose>;
 // Sorts by time and keeps the first of several poses with the same time.
 void sort_unique(Trajectory& trajectory);
 
+// The pose of `trajectory` (sorted by time) nearest `utime`, if one lies within `tolerance_us`.
+const StampedPose* pose_at(const Trajectory& trajectory, int64_t utime, int64_t tolerance_us);
+
 struct MatchConfig {
   // [us] longest reference gap interpolated across (ground truth comes every 5 ms).
   int64_t max_reference_gap_us = 500'000;
