@@ -244,8 +244,8 @@ struct LogCase {
 };
 
 // The closures that are false: by the relations where one reaches the closure (within 2 s of both
-// key poses, closure_relations.py's window), by the reference elsewhere. Prints each closure the
-// two judge differently.
+// key poses, the window of traverse-evaluator --relations), by the reference elsewhere. Prints
+// each closure the two judge differently.
 std::size_t false_closures(const evaluator::ClosureEvaluation& by_reference,
                            const evaluator::ClosureEvaluation& by_relations) {
   std::size_t n = 0;
