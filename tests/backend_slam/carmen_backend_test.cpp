@@ -247,7 +247,8 @@ struct LogCase {
 // frontend's motion [us]. The bridge's error is measured by the relations no longer than this
 // (evaluator::check_closures_by_relations), most of which are under 1 s: over a longer bridge that
 // understates the error, so a wider window makes the check stricter, not more lenient, while it
-// lets ground truth rather than the reference judge more closures.
+// lets ground truth rather than the reference judge more closures (traverse-evaluator --relations
+// reaches 2 s unless --closure-window-s says otherwise).
 constexpr int64_t kRelationWindowUs = 10'000'000;
 
 // The closures that are false: by the relations where one reaches the closure (within
