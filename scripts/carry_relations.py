@@ -10,8 +10,8 @@ copy subsampled or retimed for another benchmark: the subsampled CARMEN freiburg
 earlier. Each scan of OTHER_LOG is tied to the scan of RELATIONS_LOG with the same ranges (to the
 centimetre, as the logs print them), in order; each relation whose two scans are both in OTHER_LOG
 is written with OTHER_LOG's stamps, the rest are left out. The relations are then the ground
-truth of OTHER_LOG too, for scripts/eval-kummerle.sh --relations and
-scripts/closure_relations.py.
+truth of OTHER_LOG too, for scripts/eval-kummerle.sh --relations and traverse-evaluator
+--relations (which checks the loop closures by them too).
 
 Writes the relations to --out (default: standard output); the last line on standard error is
 JSON: scans in each log, scans tied, ties that were ambiguous (the same ranges twice, taken in

@@ -14,7 +14,8 @@
 # publishes fewer than two poses or the evaluator matches fewer relations than
 # configs/evaluator.yaml's min_reference_share. Outputs under out/eval/kummerle-NAME-STAGES/; the
 # last line is one JSON object: the evaluator's figures (relations_used, trans_mean_m,
-# trans_sd_m, rot_mean_deg, rot_sd_deg, ...), wall_s (the graph's wall-clock time), log_s (the
+# trans_sd_m, rot_mean_deg, rot_sd_deg, ...; with the backend its loop closures checked by the
+# relations: checked, median_sigmas, max_sigmas, over_sigmas, ...), wall_s (the graph's wall-clock time), log_s (the
 # log's duration), scored_log and channel (the LCM log and channel holding the trajectory that
 # was scored, for scoring it again with any tool).
 #   --stages LIST  comma-separated stage names (default frontend,backend,densifier)

@@ -37,7 +37,15 @@ std::optional<double> mahalanobis(const Eigen::Vector3d& e, const Eigen::Matrix3
 struct Truth {
   Pose2 T_true;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  std::optional<Pose2> frontend;  // the frontend's own F(from)^-1 F(to), when it is known
 };
+
+// The pose graph's error of a measurement Z against the truth: t2v(Z^-1 T_true), in Z's frame
+// (between() gives the translation there), the angle wrapped.
+Eigen::Vector3d graph_error(const Pose2& Z, const Pose2& T_true) {
+  const Pose2 E = between(Z, T_true);
+  return Eigen::Vector3d(E.x(), E.y(), wrap_angle(E.theta()));
+}
 
 // The check against any source of truth: `truth` gives a closure's Truth, or nullopt.
 template <class TruthOf>
@@ -59,9 +67,8 @@ ClosureEvaluation check_against(const std::vector<LoopClosure>& closures, const 
     }
     check.matched = true;
     check.T_true = truth->T_true;
-    // e = t2v(Z^-1 T_true): between() gives the translation in Z's frame; the angle is wrapped.
-    const Pose2 E = between(c.T_from_to, check.T_true);
-    check.error = Eigen::Vector3d(E.x(), E.y(), wrap_angle(E.theta()));
+    check.error = graph_error(c.T_from_to, check.T_true);
+    if (truth->frontend) check.frontend_error = graph_error(*truth->frontend, check.T_true);
     const double error_m = check.error.head<2>().norm();
     ++matched;
     sum_sq_m2 += error_m * error_m;
@@ -89,15 +96,14 @@ const Pose2& nearest(const Trajectory& trajectory, int64_t utime) {
 // `window_us` of each other, e = t2v(R^-1 F(t1)^-1 F(t2)), made isotropic in x and y (a bridge
 // is used in any heading). Zero with fewer than 10 such relations: the truth is then taken as
 // exact.
-Eigen::Matrix3d bridge_covariance(const Trajectory& frontend, const std::vector<Relation>& relations,
-                                  int64_t window_us) {
+Eigen::Matrix3d bridge_covariance(const Trajectory& frontend,
+                                  const std::vector<Relation>& relations, int64_t window_us) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
   int n = 0;
   for (const Relation& r : relations) {
     if (std::abs(r.t2_utime - r.t1_utime) > window_us) continue;
     const Pose2 F = between(nearest(frontend, r.t1_utime), nearest(frontend, r.t2_utime));
-    const Pose2 E = between(r.T_1_2, F);
-    const Eigen::Vector3d e(E.x(), E.y(), wrap_angle(E.theta()));
+    const Eigen::Vector3d e = graph_error(r.T_1_2, F);
     sum += e * e.transpose();
     ++n;
   }
@@ -107,6 +113,41 @@ Eigen::Matrix3d bridge_covariance(const Trajectory& frontend, const std::vector<
   c(0, 0) = c(1, 1) = 0.5 * (mean(0, 0) + mean(1, 1));
   c(2, 2) = mean(2, 2);
   return c;
+}
+
+// The relation whose ends lie nearest a closure's key poses (summed), either way round: its scans'
+// times ta (near `from`) and tb (near `to`) and the truth between them, R_a_b.
+struct Reach {
+  int64_t ta = 0, tb = 0;
+  Pose2 R_a_b;
+};
+
+// Nullopt when no relation has an end within `window_us` of each key pose.
+std::optional<Reach> nearest_relation(const LoopClosure& c, const std::vector<Relation>& relations,
+                                      int64_t window_us) {
+  std::optional<int64_t> best_us;
+  Reach reach;
+  for (const Relation& r : relations) {
+    for (const bool reversed : {false, true}) {
+      const int64_t a = reversed ? r.t2_utime : r.t1_utime;
+      const int64_t b = reversed ? r.t1_utime : r.t2_utime;
+      const int64_t da = std::abs(a - c.from_utime), db = std::abs(b - c.to_utime);
+      if (da > window_us || db > window_us || (best_us && da + db >= *best_us)) continue;
+      best_us = da + db;
+      reach = {a, b, reversed ? r.T_1_2.inverse() : r.T_1_2};
+    }
+  }
+  if (!best_us) return std::nullopt;
+  return reach;
+}
+
+// The median of `values` (the mean of the middle two for an even count); nullopt when empty.
+std::optional<double> median(std::vector<double> values) {
+  if (values.empty()) return std::nullopt;
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  if (values.size() % 2 == 1) return values[mid];
+  return 0.5 * (values[mid] + *std::max_element(values.begin(), values.begin() + mid));
 }
 
 }  // namespace
@@ -121,7 +162,7 @@ ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Traje
         const auto from = interpolator.at(c.from_utime);
         const auto to = interpolator.at(c.to_utime);
         if (!from || !to) return std::nullopt;
-        return Truth{between(from->pose, to->pose)};
+        return Truth{between(from->pose, to->pose), Eigen::Matrix3d::Zero(), std::nullopt};
       },
       false_sigmas);
 }
@@ -131,40 +172,54 @@ ClosureEvaluation check_closures_by_relations(const std::vector<LoopClosure>& cl
                                               const std::vector<Relation>& relations,
                                               int64_t window_us, double false_sigmas) {
   sort_unique(frontend);
-  const Eigen::Matrix3d bridge =
-      frontend.empty() ? Eigen::Matrix3d::Zero() : bridge_covariance(frontend, relations, window_us);
-  return check_against(
+  const Eigen::Matrix3d bridge = frontend.empty()
+                                     ? Eigen::Matrix3d::Zero()
+                                     : bridge_covariance(frontend, relations, window_us);
+  ClosureEvaluation ev = check_against(
       closures,
       [&](const LoopClosure& c) -> std::optional<Truth> {
         if (frontend.empty()) return std::nullopt;
-        // The relation whose ends lie nearest the two key poses (summed), either way round.
-        std::optional<int64_t> best_us;
-        int64_t ta = 0, tb = 0;
-        Pose2 R;
-        for (const Relation& r : relations) {
-          for (const bool reversed : {false, true}) {
-            const int64_t a = reversed ? r.t2_utime : r.t1_utime;
-            const int64_t b = reversed ? r.t1_utime : r.t2_utime;
-            const int64_t da = std::abs(a - c.from_utime), db = std::abs(b - c.to_utime);
-            if (da > window_us || db > window_us || (best_us && da + db >= *best_us)) continue;
-            best_us = da + db;
-            ta = a;
-            tb = b;
-            R = reversed ? r.T_1_2.inverse() : r.T_1_2;
-          }
-        }
-        if (!best_us) return std::nullopt;
-        const Pose2 to_a = between(nearest(frontend, c.from_utime), nearest(frontend, ta));
-        const Pose2 from_b = between(nearest(frontend, tb), nearest(frontend, c.to_utime));
+        const std::optional<Reach> reach = nearest_relation(c, relations, window_us);
+        if (!reach) return std::nullopt;
+        const Pose2& F_from = nearest(frontend, c.from_utime);
+        const Pose2& F_to = nearest(frontend, c.to_utime);
+        const Pose2 to_a = between(F_from, nearest(frontend, reach->ta));
+        const Pose2 from_b = between(nearest(frontend, reach->tb), F_to);
         // T_true = to_a * B, B = R * from_b. An error of to_a (right-perturbation d) moves T_true
         // by Ad(B^-1) d in its own frame; an error of from_b by itself.
-        Truth truth{to_a * R * from_b};
-        const Eigen::Matrix3d Ad = (R * from_b).inverse().adjoint();
-        if (ta != c.from_utime) truth.covariance += Ad * bridge * Ad.transpose();
-        if (tb != c.to_utime) truth.covariance += bridge;
+        Truth truth{to_a * reach->R_a_b * from_b, Eigen::Matrix3d::Zero(), between(F_from, F_to)};
+        const Eigen::Matrix3d Ad = (reach->R_a_b * from_b).inverse().adjoint();
+        if (reach->ta != c.from_utime) truth.covariance += Ad * bridge * Ad.transpose();
+        if (reach->tb != c.to_utime) truth.covariance += bridge;
         return truth;
       },
       false_sigmas);
+  ev.bridge_covariance = bridge;
+  return ev;
+}
+
+ClosureMedians medians(const ClosureEvaluation& evaluation) {
+  std::vector<double> error_m, error_rad, mahalanobis, frontend_m, frontend_rad;
+  ClosureMedians m;
+  for (const ClosureCheck& c : evaluation.checks) {
+    if (!c.matched) continue;
+    ++m.checked;
+    error_m.push_back(c.error.head<2>().norm());
+    error_rad.push_back(std::abs(c.error.z()));
+    m.max_error_rad = std::max(m.max_error_rad.value_or(0.0), error_rad.back());
+    if (c.mahalanobis) mahalanobis.push_back(*c.mahalanobis);
+    if (!c.frontend_error) continue;
+    frontend_m.push_back(c.frontend_error->head<2>().norm());
+    frontend_rad.push_back(std::abs(c.frontend_error->z()));
+    // Nearer by over 1 um: an exact closure beside an exact frontend is not nearer.
+    if (error_m.back() + 1e-6 < frontend_m.back()) ++m.closure_nearer;
+  }
+  m.error_m = median(error_m);
+  m.error_rad = median(error_rad);
+  m.mahalanobis = median(mahalanobis);
+  m.frontend_error_m = median(frontend_m);
+  m.frontend_error_rad = median(frontend_rad);
+  return m;
 }
 
 }  // namespace traverse::evaluator

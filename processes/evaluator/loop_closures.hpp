@@ -55,6 +55,9 @@ struct ClosureCheck {
   // sqrt(e^T C^-1 e) [unitless]; nullopt when C is not a finite positive-definite matrix.
   std::optional<double> mahalanobis;
   bool is_false = false;  // mahalanobis > false_closure_sigmas
+  // By relations: the error of the frontend's own relative pose F(from)^-1 F(to) against the same
+  // T_true, as `error`: where the closure is not nearer the truth, it cannot straighten the path.
+  std::optional<Eigen::Vector3d> frontend_error;
 };
 
 struct ClosureEvaluation {
@@ -66,7 +69,24 @@ struct ClosureEvaluation {
   std::optional<double> max_mahalanobis;  // [unitless] over matched closures with a valid C
   std::optional<double> max_error_m;      // [m] largest |e_xy| over matched closures
   std::optional<double> rms_error_m;      // [m] RMS of |e_xy| over matched closures
+  // By relations: the frontend's error over a bridge added to the truth's covariance (m^2, rad^2;
+  // zero when too few short relations measure it, or against a reference).
+  Eigen::Matrix3d bridge_covariance = Eigen::Matrix3d::Zero();
 };
+
+// Medians over the matched closures (the mean of the middle two for an even count), and the
+// frontend's error over the same pairs where it is known.
+struct ClosureMedians {
+  std::size_t checked = 0;                   // matched closures
+  std::optional<double> error_m;             // [m] of |e_xy|
+  std::optional<double> error_rad;           // [rad] of |e_theta|
+  std::optional<double> max_error_rad;       // [rad] largest |e_theta|
+  std::optional<double> mahalanobis;         // [unitless] over those with a valid covariance
+  std::optional<double> frontend_error_m;    // [m] of the frontend's |e_xy|
+  std::optional<double> frontend_error_rad;  // [rad] of the frontend's |e_theta|
+  std::size_t closure_nearer = 0;  // closures nearer the truth than the frontend by over 1 um
+};
+ClosureMedians medians(const ClosureEvaluation& evaluation);
 
 // `reference` in any order (repeated times keep their first pose); `false_sigmas` > 0.
 ClosureEvaluation check_closures(const std::vector<LoopClosure>& closures, Trajectory reference,

@@ -2,8 +2,9 @@
 // on an LCM log (--log) or live in the graph (outputs written at SIGINT/SIGTERM). The estimate
 // channel may carry pose2d_t, or the backend's key_poses_t or the densifier's dense_segments_t,
 // whose final (newest) revision is evaluated. The backend's loop closures are checked against the
-// reference. Writes errors.csv, errors.png and closures.csv under --out and prints one JSON
-// summary line last.
+// reference, or with --relations against the relations, bridged by the frontend's poses. Writes
+// errors.csv, errors.png and closures.csv (relations.csv and closures.csv with --relations) under
+// --out and prints one JSON summary line last.
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -36,6 +37,9 @@ struct Options {
   std::string align;
   std::vector<double> shift;  // dx [m], dy [m], dtheta [rad]
   std::string relations;      // a .relations file: score by relations instead (relations.hpp)
+  // [s] --relations: how far a relation's scan may lie from a closure's key pose to check it.
+  double closure_window_s = 2.0;
+  double false_closure_sigmas = 0.0;  // > 0: overrides the config's
 };
 
 // Offline runs must not need a network: look for --log before the process connects to LCM.
@@ -56,12 +60,21 @@ void add_options(CLI::App& app, Options& opt) {
                  "pose2d_t channel of the reference (ground truth or reference poses)")
       ->capture_default_str();
   app.add_option("--out", opt.out,
-                 "directory for errors.csv, errors.png and closures.csv (relations.csv with "
-                 "--relations)");
+                 "directory for errors.csv, errors.png and closures.csv (relations.csv and "
+                 "closures.csv with --relations)");
   app.add_option("--relations", opt.relations,
                  "score the estimate by the relations in FILE (Kuemmerle et al. 2009: t1 t2 dx dy "
                  "dz droll dpitch dyaw per line) instead of against --reference")
       ->check(CLI::ExistingFile);
+  app.add_option("--closure-window-s", opt.closure_window_s,
+                 "with --relations: check a loop closure by a relation with a scan within this "
+                 "many seconds of each key pose, bridged by the frontend's poses (POSE_FRONTEND)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--false-closure-sigmas", opt.false_closure_sigmas,
+                 "override the config's false_closure_sigmas: a loop closure farther from the "
+                 "truth than this many standard deviations is false")
+      ->check(CLI::PositiveNumber);
   app.add_option("--align", opt.align, "override the config's align: none, first_pose or se2")
       ->check(CLI::IsMember({"none", "first_pose", "se2"}));
   app.add_option("--shift-estimate", opt.shift,
@@ -71,17 +84,24 @@ void add_options(CLI::App& app, Options& opt) {
       ->allow_extra_args(false);
 }
 
-// errors.csv and errors.png under --out, their paths (or why there is no plot) in the JSON.
-bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
-                   const ev::ClosureEvaluation& closures, Json& json) {
+// closures.csv under --out (created), its path in the JSON; false when it cannot be written.
+bool write_closures(const Options& opt, const ev::ClosureEvaluation& closures, Json& json) {
   std::error_code ec;
   fs::create_directories(opt.out, ec);
-  const std::string closures_csv = (fs::path(opt.out) / "closures.csv").string();
-  if (!ev::write_closures_csv(closures, closures_csv)) {
-    spdlog::error("traverse-evaluator: cannot write {}", closures_csv);
+  const std::string csv = (fs::path(opt.out) / "closures.csv").string();
+  if (!ev::write_closures_csv(closures, csv)) {
+    spdlog::error("traverse-evaluator: cannot write {}", csv);
     return false;
   }
-  json["closures_csv"] = closures_csv;
+  json["closures_csv"] = csv;
+  return true;
+}
+
+// closures.csv, errors.csv and errors.png under --out, their paths (or why there is no plot) in
+// the JSON.
+bool write_outputs(const Options& opt, const ev::Evaluation& evaluation,
+                   const ev::ClosureEvaluation& closures, Json& json) {
+  if (!write_closures(opt, closures, json)) return false;
   const std::string csv = (fs::path(opt.out) / "errors.csv").string();
   const std::string png = (fs::path(opt.out) / "errors.png").string();
   if (!ev::write_errors_csv(evaluation, csv)) {
@@ -158,6 +178,26 @@ int score_relations(const Options& opt, const ev::EvaluatorConfig& cfg,
   return r.refused ? 1 : 0;
 }
 
+// --relations: the loop closures checked by the relations (check_closures_by_relations), bridged
+// by the frontend's poses; closures.csv under --out. False when the file cannot be written.
+bool report_closures_by_relations(const Options& opt, const ev::EvaluatorConfig& cfg,
+                                  const ev::RelationsFile& file, const ev::PoseCollector& collector,
+                                  Json& json) {
+  if (collector.frontend().empty() && collector.closures().size() > 0) {
+    spdlog::warn(
+        "traverse-evaluator: no pose on {}: the loop closures cannot be checked by the "
+        "relations",
+        traverse::channels::kPoseFrontend);
+  }
+  const ev::ClosureEvaluation closures = ev::check_closures_by_relations(
+      collector.closures().closures(), collector.frontend(), file.relations,
+      std::llround(1e6 * opt.closure_window_s), cfg.false_closure_sigmas);
+  ev::add_closures_by_relations(closures, opt.closure_window_s, cfg.false_closure_sigmas, json);
+  json["frontend_channel"] = traverse::channels::kPoseFrontend;
+  json["frontend_poses"] = collector.frontend().size();
+  return opt.out.empty() || write_closures(opt, closures, json);
+}
+
 // A channel carrying several types is an error of the graph, not of the figures: say so loudly.
 void report_type_problems(const ev::PoseCollector& collector, const std::string& estimate_channel) {
   if (collector.mixed_type_messages() == 0) return;
@@ -187,6 +227,7 @@ int main(int argc, char** argv) {
   const bool offline = has_log_option(argc, argv);
   if (auto rc = proc.start(argc, argv, cfg, !offline)) return *rc;
   if (!opt.align.empty()) cfg.align = opt.align;
+  if (opt.false_closure_sigmas > 0.0) cfg.false_closure_sigmas = opt.false_closure_sigmas;
   if (auto error = ev::validate(cfg)) {
     spdlog::error("traverse-evaluator: config error: {} (in {})", *error,
                   proc.config_path().empty() ? "defaults" : proc.config_path());
@@ -206,7 +247,9 @@ int main(int argc, char** argv) {
     }
   }
 
-  ev::PoseCollector collector(opt.estimate, opt.reference, cfg.key_poses_channel);
+  // The frontend's poses bridge loop closures to relations; without relations they are not used.
+  ev::PoseCollector collector(opt.estimate, opt.reference, cfg.key_poses_channel,
+                              opt.relations.empty() ? "" : traverse::channels::kPoseFrontend);
   ev::PoseCollector::LogSummary log_summary;
   if (offline) {
     try {
@@ -232,7 +275,8 @@ int main(int argc, char** argv) {
   report_type_problems(collector, opt.estimate);
   Json json;
   if (!opt.relations.empty()) {
-    const int rc = score_relations(opt, cfg, relations, estimate, json);
+    int rc = score_relations(opt, cfg, relations, estimate, json);
+    if (!report_closures_by_relations(opt, cfg, relations, collector, json)) rc = 1;
     add_input_facts(opt, collector, offline, log_summary, json);
     std::cout << json_line(json) << std::endl;
     return rc;

@@ -48,16 +48,18 @@ std::string estimate_type_name(EstimateType type) {
 }
 
 PoseCollector::PoseCollector(std::string estimate_channel, std::string reference_channel,
-                             std::string key_poses_channel)
+                             std::string key_poses_channel, std::string frontend_channel)
     : estimate_channel_(std::move(estimate_channel)),
       reference_channel_(std::move(reference_channel)),
-      key_poses_channel_(std::move(key_poses_channel)) {}
+      key_poses_channel_(std::move(key_poses_channel)),
+      frontend_channel_(std::move(frontend_channel)) {}
 
 void PoseCollector::on_event(const std::string& channel, const void* data, int size) {
   const bool estimate = channel == estimate_channel_;
   const bool reference = channel == reference_channel_;
   const bool key_poses = channel == key_poses_channel_;
-  if (!estimate && !reference && !key_poses) return;
+  const bool frontend = !frontend_channel_.empty() && channel == frontend_channel_;
+  if (!estimate && !reference && !key_poses && !frontend) return;
   const TypeInfo* type = find_type(data, static_cast<std::size_t>(size));
   if (type == nullptr) {
     ++decode_failures_;
@@ -67,6 +69,7 @@ void PoseCollector::on_event(const std::string& channel, const void* data, int s
   if (reference) add_reference(type->name, data, size);
   // Another type on the key-poses channel is not ours to judge unless it is the estimate too.
   if (key_poses && type->name == kKeyPosesName) add_closures(data, size);
+  if (frontend && type->name == kPose2dName) add_frontend(data, size);
 }
 
 void PoseCollector::add_estimate(const std::string& type_name, const void* data, int size) {
@@ -157,6 +160,22 @@ void PoseCollector::add_closures(const void* data, int size) {
   }
 }
 
+void PoseCollector::add_frontend(const void* data, int size) {
+  pose2d_t m{};
+  // Counted where the estimate or reference read the same message already.
+  const bool counted =
+      frontend_channel_ == estimate_channel_ || frontend_channel_ == reference_channel_;
+  if (!decode(data, size, m)) {
+    if (!counted) ++decode_failures_;
+    return;
+  }
+  if (!finite(m.x, m.y, m.theta)) {
+    if (!counted) ++non_finite_poses_;
+    return;
+  }
+  frontend_.push_back({m.utime, Pose2(m.x, m.y, m.theta)});
+}
+
 Trajectory PoseCollector::estimate() const {
   switch (estimate_type_) {
     case EstimateType::kKeyPoses:
@@ -186,6 +205,7 @@ std::size_t PoseCollector::estimate_size() const {
 void PoseCollector::subscribe(Bus& bus) {
   // Raw subscriptions: the type is decided per message from its fingerprint, exactly as offline.
   std::set<std::string> channels = {estimate_channel_, reference_channel_, key_poses_channel_};
+  if (!frontend_channel_.empty()) channels.insert(frontend_channel_);
   for (const std::string& channel : channels) {
     bus.subscribe_raw(channel, [this](const std::string& ch, const uint8_t* data, int size,
                                       int64_t) { on_event(ch, data, size); });

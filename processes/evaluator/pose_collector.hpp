@@ -7,7 +7,9 @@
 //   dense_segments_t  the newest revision of each segment (final_trajectory.hpp).
 // The first of these seen decides the channel's type; a message of any other type on it is
 // counted as a mixed-type message and dropped. The reference is pose2d_t. Loop closures come from
-// key_poses_t messages on the key-poses channel (which may also be the estimate channel).
+// key_poses_t messages on the key-poses channel (which may also be the estimate channel). The
+// frontend's pose2d_t (optional, e.g. to bridge closures to relations) come from its own channel,
+// which may be the estimate channel too.
 #pragma once
 
 #include <cstddef>
@@ -28,17 +30,18 @@ std::string estimate_type_name(EstimateType type);
 
 class PoseCollector {
  public:
+  // `frontend_channel` empty: no frontend poses are collected.
   PoseCollector(std::string estimate_channel, std::string reference_channel,
-                std::string key_poses_channel);
+                std::string key_poses_channel, std::string frontend_channel = "");
 
-  // Live: every message on the three channels (one subscription per distinct channel).
+  // Live: every message on our channels (one subscription per distinct channel).
   void subscribe(Bus& bus);
 
   struct LogSummary {
     std::size_t events = 0;           // events read
     std::size_t damaged_records = 0;  // damaged places the reader skipped
   };
-  // Offline: every message on the three channels of an LCM log. Throws std::runtime_error if the
+  // Offline: every message on our channels of an LCM log. Throws std::runtime_error if the
   // file cannot be opened.
   LogSummary read_log(const std::string& path);
 
@@ -50,6 +53,7 @@ class PoseCollector {
   Trajectory estimate() const;
   std::size_t estimate_size() const;  // cheap: poses, key poses or segments so far
   const Trajectory& reference() const { return reference_; }
+  const Trajectory& frontend() const { return frontend_; }  // pose2d_t on the frontend channel
   const LoopClosureSet& closures() const { return closures_; }
   const KeyPoseTrajectory& key_poses() const { return key_poses_; }
   const DenseTrajectory& dense() const { return dense_; }
@@ -68,15 +72,18 @@ class PoseCollector {
   void add_estimate(const std::string& type_name, const void* data, int size);
   void add_reference(const std::string& type_name, const void* data, int size);
   void add_closures(const void* data, int size);
+  void add_frontend(const void* data, int size);
 
   std::string estimate_channel_;
   std::string reference_channel_;
   std::string key_poses_channel_;
+  std::string frontend_channel_;
   EstimateType estimate_type_ = EstimateType::kNone;
   Trajectory pose2d_estimate_;
   KeyPoseTrajectory key_poses_;
   DenseTrajectory dense_;
   Trajectory reference_;
+  Trajectory frontend_;
   LoopClosureSet closures_;
   std::size_t non_finite_poses_ = 0;
   std::size_t decode_failures_ = 0;

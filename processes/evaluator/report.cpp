@@ -56,21 +56,26 @@ bool write_closures_csv(const ClosureEvaluation& ev, const std::string& path) {
   if (!out) return false;
   out << "from_id,to_id,from_utime_us,to_utime_us,matched,meas_x_m,meas_y_m,meas_theta_deg,"
          "true_x_m,true_y_m,true_theta_deg,err_x_m,err_y_m,err_theta_deg,err_xy_m,sigma_x_m,"
-         "sigma_y_m,sigma_theta_deg,mahalanobis,false\n";
+         "sigma_y_m,sigma_theta_deg,mahalanobis,false,frontend_err_x_m,frontend_err_y_m,"
+         "frontend_err_theta_deg,frontend_err_xy_m\n";
   // Empty fields where there is no value (unmatched, or a covariance that is not positive
   // definite), so that a reader never mistakes them for zero.
   const auto num = [](bool have, double v) { return have ? fmt::format("{:.6f}", v) : ""; };
   for (const ClosureCheck& c : ev.checks) {
     const LoopClosure& l = c.closure;
     const bool m = c.matched;
+    const bool f = c.frontend_error.has_value();
+    const Eigen::Vector3d fe = c.frontend_error.value_or(Eigen::Vector3d::Zero());
     out << fmt::format(
-        "{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{}\n",
+        "{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{},{},{:.6f},{:.6f},{:.6f},{},{},"
+        "{},{},{},{}\n",
         l.from_id, l.to_id, l.from_utime, l.to_utime, m ? 1 : 0, l.T_from_to.x(), l.T_from_to.y(),
         kDegPerRad * l.T_from_to.theta(), num(m, c.T_true.x()), num(m, c.T_true.y()),
         num(m, kDegPerRad * c.T_true.theta()), num(m, c.error.x()), num(m, c.error.y()),
         num(m, kDegPerRad * c.error.z()), num(m, c.error.head<2>().norm()), c.sigma.x(),
         c.sigma.y(), kDegPerRad * c.sigma.z(),
-        num(c.mahalanobis.has_value(), c.mahalanobis.value_or(0.0)), c.is_false ? 1 : 0);
+        num(c.mahalanobis.has_value(), c.mahalanobis.value_or(0.0)), c.is_false ? 1 : 0,
+        num(f, fe.x()), num(f, fe.y()), num(f, kDegPerRad * fe.z()), num(f, fe.head<2>().norm()));
   }
   return static_cast<bool>(out.flush());
 }
@@ -141,6 +146,33 @@ void add_closures(const ClosureEvaluation& ev, Json& json) {
   json["loop_closure_max_mahalanobis"] = json_fixed(ev.max_mahalanobis, 3);
   json["loop_closure_max_error_m"] = json_fixed(ev.max_error_m, 6);
   json["loop_closure_rms_error_m"] = json_fixed(ev.rms_error_m, 6);
+}
+
+void add_closures_by_relations(const ClosureEvaluation& ev, double window_s, double sigmas,
+                               Json& json) {
+  const ClosureMedians m = medians(ev);
+  const auto deg = [](std::optional<double> rad) -> std::optional<double> {
+    if (!rad) return std::nullopt;
+    return kDegPerRad * *rad;
+  };
+  json["closures"] = ev.closures;
+  json["checked"] = m.checked;
+  json["window_s"] = window_s;
+  json["sigmas"] = sigmas;
+  json["bridge_sigma_m"] = json_fixed(std::sqrt(ev.bridge_covariance(0, 0)), 4);
+  json["bridge_sigma_deg"] = json_fixed(kDegPerRad * std::sqrt(ev.bridge_covariance(2, 2)), 3);
+  json["median_error_m"] = json_fixed(m.error_m, 4);
+  json["max_error_m"] = json_fixed(ev.max_error_m, 4);
+  json["median_error_deg"] = json_fixed(deg(m.error_rad), 3);
+  json["max_error_deg"] = json_fixed(deg(m.max_error_rad), 3);
+  // 1.54 (the square root of chi-square 3's median) when the covariances are right.
+  json["median_sigmas"] = json_fixed(m.mahalanobis, 2);
+  json["max_sigmas"] = json_fixed(ev.max_mahalanobis, 2);
+  json["over_sigmas"] = ev.false_closures;
+  json["closures_bad_covariance"] = ev.bad_covariance;
+  json["frontend_median_error_m"] = json_fixed(m.frontend_error_m, 4);
+  json["frontend_median_error_deg"] = json_fixed(deg(m.frontend_error_rad), 3);
+  json["closure_nearer"] = m.checked > 0 ? Json(m.closure_nearer) : Json();
 }
 
 void add_relations(const RelationsEvaluation& ev, Json& json) {

@@ -1,11 +1,13 @@
 #!/usr/bin/python3
-"""scripts/closure_relations.py on a crafted run: a cart on a 10 m circle (so headings matter and
-a relation's yaw, its 8th field, must be read), the frontend exactly on it, and three closures:
-one exact, one 0.3 m off, one with no relation near its key poses. The check must find the first
-within a sigma, the second far over 5 sigmas, and leave the third unchecked.
+"""traverse-evaluator --relations checking loop closures on a crafted run: a cart on a 10 m circle
+(so headings matter and a relation's yaw, its 8th field, must be read), the frontend exactly on
+it, and three closures: one exact, one 0.3 m off, one with no relation near its key poses. The
+check must find the first within a sigma, the second far over 5 sigmas, and leave the third
+unchecked.
 
     closure_relations_test.py BUILD_DIR
 """
+import csv
 import json
 import math
 import os
@@ -81,16 +83,28 @@ class ClosureRelationsTest(unittest.TestCase):
                 for t1, t2 in ((10.5, 49.2), (71.0, 19.4)):
                     r = between(pose(t1), pose(t2))
                     f.write(f"{t1:.6f} {t2:.6f} {r[0]:.6f} {r[1]:.6f} 0 0 0 {r[2]:.6f}\n")
+            out_dir = os.path.join(d, "out")
             out = subprocess.run(
-                [sys.executable, os.path.join(SCRIPTS, "closure_relations.py"), d, relations,
-                 "--build-dir", BUILD], capture_output=True, text=True, check=True).stdout
+                [os.path.join(BUILD, "bin", "traverse-evaluator"), "--log", log, "--relations",
+                 relations, "--out", out_dir], capture_output=True, text=True, check=True).stdout
             summary = json.loads(out.strip().splitlines()[-1])
+            self.assertEqual(summary["frontend_poses"], 1001)
+            self.assertEqual(summary["window_s"], 2.0)
+            self.assertEqual(summary["sigmas"], 5.0)
             self.assertEqual(summary["closures"], 3)
             self.assertEqual(summary["checked"], 2)  # 30 -> 35 s has no relation near it
             self.assertEqual(summary["over_sigmas"], 1)
             self.assertAlmostEqual(summary["max_error_m"], 0.3, delta=0.005)
             self.assertGreater(summary["max_sigmas"], 10.0)
-            self.assertIn("100 -> 500: error 0.000 m", out)
+            # Two checked: the median is the mean of the two, as statistics.median's.
+            self.assertAlmostEqual(summary["median_error_m"], 0.15, delta=0.003)
+            with open(os.path.join(out_dir, "closures.csv")) as f:
+                rows = {(r["from_id"], r["to_id"]): r for r in csv.DictReader(f)}
+            self.assertAlmostEqual(float(rows[("100", "500")]["err_xy_m"]), 0.0, delta=1e-4)
+            self.assertAlmostEqual(float(rows[("200", "700")]["err_xy_m"]), 0.3, delta=0.005)
+            self.assertEqual(rows[("200", "700")]["false"], "1")
+            self.assertEqual(rows[("300", "350")]["matched"], "0")
+            self.assertEqual(rows[("300", "350")]["frontend_err_xy_m"], "")
             # The frontend lies on the truth: no closure is nearer to it.
             self.assertLess(summary["frontend_median_error_m"], 1e-4)
             self.assertEqual(summary["closure_nearer"], 0)

@@ -1,6 +1,8 @@
 // The collector on a live bus (memq://, in process): the same results as from a log.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "bus.hpp"
 #include "evaluator.hpp"
 #include "messages.hpp"
@@ -110,6 +112,32 @@ TEST_F(CollectorLive, MixedTypesAreCountedAndDropped) {
   EXPECT_EQ(c.mixed_type_messages(), 3u);
   EXPECT_EQ(c.estimate_types_seen().size(), 3u);
   EXPECT_TRUE(c.reference().empty());
+}
+
+TEST_F(CollectorLive, FrontendPosesAreCollectedBesideAnotherEstimate) {
+  PoseCollector c("KEY_POSES", "POSE_GROUND_TRUTH", "KEY_POSES", "POSE_FRONTEND");
+  c.subscribe(bus_);
+  publish("KEY_POSES", test::key_poses(1, {test::key_pose(0, 2'000'000)}));
+  pose2d_t pose{};
+  pose.utime = 2'000'000;
+  publish("POSE_FRONTEND", pose);
+  pose.utime = 2'100'000;
+  pose.x = std::nan("");
+  publish("POSE_FRONTEND", pose);  // left out and counted
+  imu_t imu{};
+  imu.utime = 2'200'000;
+  publish("POSE_FRONTEND", imu);  // not the frontend's type: not ours to judge
+  deliver();
+  EXPECT_EQ(c.estimate_type(), EstimateType::kKeyPoses);
+  ASSERT_EQ(c.frontend().size(), 1u);
+  EXPECT_EQ(c.frontend()[0].utime, 2'000'000);
+  EXPECT_EQ(c.non_finite_poses(), 1u);
+  EXPECT_EQ(c.mixed_type_messages(), 0u);
+  // Without a frontend channel nothing is kept.
+  PoseCollector none("KEY_POSES", "POSE_GROUND_TRUTH", "KEY_POSES");
+  none.on_event("POSE_FRONTEND", nullptr, 0);
+  EXPECT_TRUE(none.frontend().empty());
+  EXPECT_EQ(none.decode_failures(), 0u);
 }
 
 }  // namespace

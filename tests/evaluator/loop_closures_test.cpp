@@ -189,6 +189,47 @@ TEST(LoopClosuresByRelations, ARelationIsUsedEitherWayRoundAndTheNearestWins) {
   EXPECT_NEAR(*ev.max_error_m, 0.2, 1e-9);
 }
 
+TEST(LoopClosuresByRelations, MediansSetTheClosuresBesideTheFrontendsOwnRelativePose) {
+  const std::vector<Relation> relations = {relation(3'600'000, 14'800'000)};
+  const std::vector<LoopClosure> closures = {
+      closure(1, 40, 3'000'000, 16'000'000),                          // exact
+      closure(2, 41, 3'000'000, 16'000'000, Pose2(0.0, 0.06, 0.01)),  // 3 and 2 sigmas
+      closure(3, 42, 3'000'000, 6'000'000),                           // no relation near
+  };
+  const Trajectory f = slipping_frontend();
+  const ClosureEvaluation ev =
+      check_closures_by_relations(closures, f, relations, 2'000'000, kFive);
+  // The frontend's own relative pose across its slip, against the same truth: the same for both
+  // checked closures, none for the unchecked one.
+  const Pose2 E = between(between(f[20].pose, f[150].pose), ev.checks[0].T_true);  // 3 s, 16 s
+  const Eigen::Vector3d slip_error(E.x(), E.y(), wrap_angle(E.theta()));
+  ASSERT_TRUE(ev.checks[0].frontend_error && ev.checks[1].frontend_error);
+  EXPECT_TRUE(ev.checks[0].frontend_error->isApprox(slip_error, 1e-9));
+  EXPECT_FALSE(ev.checks[2].frontend_error);
+  EXPECT_GT(slip_error.head<2>().norm(), 0.1);
+  const ClosureMedians m = medians(ev);
+  EXPECT_EQ(m.checked, 2u);
+  // Two values: the median is the mean of the two.
+  EXPECT_NEAR(m.error_m.value(), 0.03, 1e-9);
+  EXPECT_NEAR(m.error_rad.value(), 0.005, 1e-9);
+  EXPECT_NEAR(m.max_error_rad.value(), 0.01, 1e-9);
+  EXPECT_NEAR(m.mahalanobis.value(), 0.5 * std::hypot(3.0, 2.0), 1e-6);
+  EXPECT_NEAR(m.frontend_error_m.value(), slip_error.head<2>().norm(), 1e-9);
+  EXPECT_NEAR(m.frontend_error_rad.value(), std::abs(slip_error.z()), 1e-9);
+  EXPECT_EQ(m.closure_nearer, 2u);  // both nearer the truth than the slipped frontend
+  // Three values: the middle one.
+  std::vector<LoopClosure> three = closures;
+  three[2] = closure(4, 43, 3'000'000, 16'000'000, Pose2(0.0, 0.02, 0.0));
+  EXPECT_NEAR(
+      medians(check_closures_by_relations(three, f, relations, 2'000'000, kFive)).error_m.value(),
+      0.02, 1e-9);
+  // Nothing checked: no figure, not zero.
+  const ClosureMedians none =
+      medians(check_closures_by_relations({closures[2]}, f, relations, 2'000'000, kFive));
+  EXPECT_EQ(none.checked, 0u);
+  EXPECT_FALSE(none.error_m || none.mahalanobis || none.frontend_error_m);
+}
+
 TEST(LoopClosuresByRelations, AClosureNoRelationReachesIsUnmatched) {
   const std::vector<Relation> relations = {relation(3'000'000, 12'000'000)};  // 4 s from `to`
   const ClosureEvaluation ev = check_closures_by_relations(
@@ -227,11 +268,13 @@ TEST(LoopClosuresByRelations, TheFrontendsErrorOverShortSpansWidensTheTruthsCova
   // (The bridge turns its translation by the wobble, 5 mm against sigmas of 1-2 cm: 3 %.)
   EXPECT_NEAR(ev.checks[0].mahalanobis.value(), expected, 0.03 * expected);
   EXPECT_FALSE(ev.checks[0].is_false);
+  EXPECT_NEAR(ev.bridge_covariance(2, 2), 0.02 * 0.02, 1e-12);
   // Without the short relations the same closure is six sigmas off.
   relations.erase(relations.begin(), relations.begin() + 30);
   const ClosureEvaluation alone =
       check_closures_by_relations({c}, wobbling, relations, 2'000'000, kFive);
   EXPECT_NEAR(alone.checks[0].mahalanobis.value(), 6.0, 0.01);
+  EXPECT_TRUE(alone.bridge_covariance.isZero());
   EXPECT_TRUE(alone.checks[0].is_false);
 }
 
