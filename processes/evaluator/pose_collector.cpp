@@ -129,16 +129,7 @@ void PoseCollector::add_reference(const std::string& type_name, const void* data
     ++mixed_type_messages_;
     return;
   }
-  pose2d_t m;
-  if (!decode(data, size, m)) {
-    ++decode_failures_;
-    return;
-  }
-  if (!finite(m.x, m.y, m.theta)) {
-    ++non_finite_poses_;
-    return;
-  }
-  reference_.push_back({m.utime, Pose2(m.x, m.y, m.theta)});
+  add_pose(data, size, reference_, true);
 }
 
 void PoseCollector::add_closures(const void* data, int size) {
@@ -161,19 +152,23 @@ void PoseCollector::add_closures(const void* data, int size) {
 }
 
 void PoseCollector::add_frontend(const void* data, int size) {
-  pose2d_t m{};
   // Counted where the estimate or reference read the same message already.
   const bool counted =
       frontend_channel_ == estimate_channel_ || frontend_channel_ == reference_channel_;
+  add_pose(data, size, frontend_, !counted);
+}
+
+void PoseCollector::add_pose(const void* data, int size, Trajectory& into, bool count) {
+  pose2d_t m{};
   if (!decode(data, size, m)) {
-    if (!counted) ++decode_failures_;
+    if (count) ++decode_failures_;
     return;
   }
   if (!finite(m.x, m.y, m.theta)) {
-    if (!counted) ++non_finite_poses_;
+    if (count) ++non_finite_poses_;
     return;
   }
-  frontend_.push_back({m.utime, Pose2(m.x, m.y, m.theta)});
+  into.push_back({m.utime, Pose2(m.x, m.y, m.theta)});
 }
 
 Trajectory PoseCollector::estimate() const {

@@ -73,6 +73,9 @@ class PoseCollector {
   void add_reference(const std::string& type_name, const void* data, int size);
   void add_closures(const void* data, int size);
   void add_frontend(const void* data, int size);
+  // A pose2d_t onto `into`; a message that does not decode or is not finite is left out, and
+  // counted when `count`.
+  void add_pose(const void* data, int size, Trajectory& into, bool count);
 
   std::string estimate_channel_;
   std::string reference_channel_;
