@@ -266,6 +266,8 @@ void BackendNode::report_counters() {
   counters_("key_poses_without_scan", static_cast<double>(c.key_poses_without_scan));
   counters_("links_matched", static_cast<double>(c.links_matched));
   counters_("links_fallback", static_cast<double>(c.links_fallback));
+  counters_("links_opened", static_cast<double>(c.links_opened));
+  counters_("links_held", static_cast<double>(c.links_held));
   counters_("links_refined", static_cast<double>(c.links_refined));
   const OdometryCounters& o = backend_.odometry_counters();
   counters_("odometry_readings", static_cast<double>(o.readings));
@@ -301,6 +303,10 @@ void BackendNode::report_counters() {
   counters_("boresight_estimate_rad", backend_.boresight().estimate_rad());
   counters_("boresight_yaw_sigma_rad", backend_.boresight().yaw_sigma_rad());
   counters_("boresight_chords", static_cast<double>(backend_.boresight().chords()));
+  counters_("start_frame_heading_rad", backend_.start_frame().heading_rad().value_or(0.0));
+  counters_("start_frame_estimate_rad", backend_.start_frame().estimate_rad());
+  counters_("start_frame_early_rad", backend_.start_frame().early_estimate_rad());
+  counters_("start_frame_matches", static_cast<double>(backend_.start_frame().matches()));
   if (!state_) return;
   const BackendStateCounters& s = state_->counters();
   counters_("state_snapshots", static_cast<double>(s.snapshots));

@@ -211,6 +211,8 @@ RefineResult ScanRefiner::refine(const std::vector<Eigen::Vector2d>& reference,
   const double dof = std::max(weight_sum - 3.0, 1.0);
   const double sigma2 = weighted_sq / dof;
   result.covariance = c.covariance_scale * sigma2 * inverse_constrained(H, lever_m);
+  result.information = sigma2 > 0.0 ? H / (c.covariance_scale * sigma2) : H;
+  result.lever_m = lever_m;
   result.valid = result.covariance.allFinite();
   if (!result.valid) result.T_world_query = T_world_start;
   return result;

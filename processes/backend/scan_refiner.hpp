@@ -64,6 +64,12 @@ struct RefineResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // world frame: m^2, m rad, rad^2
   double rms_residual_m = 0.0;   // [m] weighted RMS point-to-line distance at the end
   double inlier_fraction = 0.0;  // query points with a correspondence at the end [0..1]
+  // The information behind `covariance` without the floor its unconstrained directions are
+  // raised to (covariance^-1 where every direction is constrained; world frame), and the lever
+  // [m] the heading is weighed at (the query points' RMS range): common/degeneracy.hpp tells
+  // from them which directions the scans leave open.
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  double lever_m = 1.0;
   int iterations = 0;
 };
 

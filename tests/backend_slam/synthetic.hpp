@@ -13,17 +13,24 @@ namespace traverse::backend::test {
 
 namespace synthetic = traverse::frontend::synthetic;
 
-// A 360 degree sweep of n beams with max range `range_max_m`, as the backend's scan type.
-inline PlanarScan sweep(const synthetic::World& world, const Pose2& T_world_base,
-                        double range_max_m, std::mt19937& rng, int n = 1440,
-                        int64_t utime_first = 0, double noise_m = 0.005) {
+// The spec of a 360 degree sweep of n beams with max range `range_max_m` and Gaussian range noise.
+inline synthetic::SweepSpec full_sweep_spec(int n = 1440, double range_max_m = 20.0,
+                                            double noise_m = 0.005) {
   synthetic::SweepSpec spec;
   spec.n_ranges = n;
   spec.angle_first = -M_PI;
   spec.angle_step = 2.0 * M_PI / n;
-  spec.utime_first = utime_first;
   spec.range_max = range_max_m;
   spec.noise_sigma_m = noise_m;
+  return spec;
+}
+
+// A 360 degree sweep of n beams with max range `range_max_m`, as the backend's scan type.
+inline PlanarScan sweep(const synthetic::World& world, const Pose2& T_world_base,
+                        double range_max_m, std::mt19937& rng, int n = 1440,
+                        int64_t utime_first = 0, double noise_m = 0.005) {
+  synthetic::SweepSpec spec = full_sweep_spec(n, range_max_m, noise_m);
+  spec.utime_first = utime_first;
   return synthetic::make_sweep(
       world, [&](int64_t) { return T_world_base; }, Pose2(), spec, &rng);
 }
@@ -111,13 +118,8 @@ inline Drive drive_ellipse(double duration_s, unsigned seed = 5) {
   std::mt19937 rng(seed);
   Drive d;
   const int64_t period_us = 100000, sweep_us = 20964;
-  synthetic::SweepSpec spec;
-  spec.n_ranges = 1440;
-  spec.angle_first = -M_PI;
-  spec.angle_step = 2.0 * M_PI / spec.n_ranges;
+  synthetic::SweepSpec spec = full_sweep_spec();
   spec.duration_us = sweep_us;
-  spec.range_max = 20.0;
-  spec.noise_sigma_m = 0.005;
   const auto truth_at = [](int64_t t) { return ellipse_pose(1e-6 * static_cast<double>(t)); };
   for (int64_t t0 = 0; 1e-6 * static_cast<double>(t0) < duration_s; t0 += period_us) {
     spec.utime_first = t0;

@@ -1,4 +1,4 @@
-#include "hector/degeneracy.hpp"
+#include "degeneracy.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace traverse::frontend {
+namespace traverse {
 namespace {
 
 // S maps the scaled coordinates (x, y, L theta) to (x, y, theta).
@@ -73,4 +73,35 @@ Eigen::Matrix3d remapped_covariance(const Degeneracy& d,
   return S * scaled * S;
 }
 
-}  // namespace traverse::frontend
+Eigen::Matrix3d held_covariance(const Degeneracy& d, const Eigen::Matrix3d& covariance_matched,
+                                const Eigen::Matrix3d& covariance_predicted) {
+  const Eigen::Matrix3d S = scale(d.length_m);
+  const Eigen::Matrix3d S_inv = S.inverse();
+  const Eigen::Matrix3d matched = S_inv * covariance_matched * S_inv;
+  const Eigen::Matrix3d predicted = S_inv * covariance_predicted * S_inv;
+  Eigen::Matrix3d well = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d held = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d v = d.directions_scaled.col(i);
+    if (i < d.directions) {
+      held += v.dot(predicted * v) * v * v.transpose();
+    } else {
+      well += v * v.transpose();
+    }
+  }
+  return S * (well * matched * well + held) * S;
+}
+
+Eigen::Matrix3d opened_covariance(const Degeneracy& d, const Eigen::Matrix3d& covariance,
+                                  double sigma_m) {
+  const Eigen::Matrix3d S = scale(d.length_m);
+  Eigen::Matrix3d opened = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < d.directions; ++i) {
+    const Eigen::Vector3d v = d.directions_scaled.col(i);
+    const double variance = 1.0 / std::max(d.eigenvalues(i), 1.0 / (sigma_m * sigma_m));
+    opened += variance * v * v.transpose();
+  }
+  return covariance + S * opened * S;
+}
+
+}  // namespace traverse

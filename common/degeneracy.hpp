@@ -15,7 +15,8 @@
 // directions (xi = xi_pred + P (xi_match - xi_pred), P the projector onto them), and its covariance
 // is the match's there and the prediction's along the degenerate directions: a corridor's axis
 // comes out with the variance the motion prior has grown to, not the millimetres the map's history
-// claims.
+// claims. Used by the Hector frontend (its scan-to-map match) and by the backend (its links between
+// key scans, backend.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -23,7 +24,7 @@
 
 #include "se2.hpp"
 
-namespace traverse::frontend {
+namespace traverse {
 
 struct Degeneracy {
   int directions = 0;  // degenerate eigen-directions (0: the match determines the whole pose)
@@ -56,4 +57,18 @@ Pose2 remap(const Degeneracy& d, const Pose2& T_predicted, const Pose2& T_matche
 Eigen::Matrix3d remapped_covariance(const Degeneracy& d,
                                     const Eigen::Matrix3d& covariance_predicted);
 
-}  // namespace traverse::frontend
+// The covariance of a match held along the degenerate directions (remap): the match's own
+// covariance along the well-determined ones, the prediction's along the degenerate ones (each
+// projected onto its direction; the two do not mix).
+Eigen::Matrix3d held_covariance(const Degeneracy& d, const Eigen::Matrix3d& covariance_matched,
+                                const Eigen::Matrix3d& covariance_predicted);
+
+// A covariance opened along the degenerate directions: each gets the variance its own
+// information allows there (1 / lambda, in metres of point motion: over L^2 for the heading), at
+// most sigma_m^2, on top; the others are left as they are. For a match whose own covariance does
+// not see what its geometry leaves open (the backend's links: a correlative response surface is
+// bounded by its search window).
+Eigen::Matrix3d opened_covariance(const Degeneracy& d, const Eigen::Matrix3d& covariance,
+                                  double sigma_m);
+
+}  // namespace traverse
