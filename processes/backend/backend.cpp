@@ -7,17 +7,10 @@
 #include <cstdlib>
 
 #include "config.hpp"
-#include "degeneracy.hpp"
 #include "frontend_chain.hpp"
 
 namespace traverse::backend {
 namespace {
-
-// A link is held along an open direction at the odometry's step only over a stream's key step
-// (a third of a second; at most half a second): not where a log subsampled by travel has its key
-// scans seconds apart, nor at its first poses, before five intervals tell it from a stream (one
-// link held there on the CARMEN aces log moved its position RMSE from 0.186 to 0.224 m).
-constexpr int64_t kMaxHeldLinkStepUs = 500000;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -60,8 +53,7 @@ std::optional<std::string> validate(const BackendConfig& c) {
 
 Backend::Backend(BackendConfig config)
     : config_(std::move(config)),
-      drift_model_(config_.frontend_drift_length_m > 0.0 && config_.frontend_sigma_xy_m > 0.0 &&
-                   config_.frontend_sigma_theta_rad > 0.0),
+      drift_model_(config_.frontend_drift_length_m > 0.0 && frontend_edges()),
       T_base_laser_(config_.T_base_laser.pose()),
       link_matcher_(config_.link),
       link_refiner_(config_.link_refine),
@@ -122,27 +114,6 @@ std::optional<BackendUpdate> Backend::take_pose(const PreparedPose& pose) {
   if (closure) add_closure(*closure);
   if (closure || current % config_.optimize_every == 0) return optimise();
   return std::nullopt;
-}
-
-void Backend::hold_open_directions(const RefineResult& refined, int64_t from_utime,
-                                   int64_t to_utime, const Pose2& T_world_from,
-                                   const Pose2& frontend_motion, Pose2& T_world_key,
-                                   Eigen::Matrix3d& covariance) {
-  if (config_.link_degeneracy_min_ratio <= 0.0) return;
-  const Degeneracy d =
-      analyse_degeneracy(refined.information, refined.lever_m, config_.link_degeneracy_min_ratio);
-  if (d.directions == 0) return;
-  ++counters_.links_opened;
-  const std::optional<OdometryStep> odometry =
-      odometry_.compare(from_utime, to_utime, frontend_motion, Eigen::Matrix3d::Zero());
-  if (!odometry || odometry->frontend_rejected) {
-    covariance = opened_covariance(d, covariance, config_.link_open_sigma_m);
-    return;
-  }
-  T_world_key = remap(d, T_world_from * odometry->motion, T_world_key);
-  covariance = held_covariance(d, covariance,
-                               rotate_covariance(odometry->covariance, T_world_from.rotation()));
-  ++counters_.links_held;
 }
 
 Pose2 Backend::published_pose(int i) const {
@@ -239,131 +210,37 @@ void Backend::add_key_pose(const PlanarScan& scan) {
   KeyPose key;
   key.utime = now.utime;
   key.travel_m = now.travel_m;
-  const bool frontend = config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
+  const bool frontend = frontend_edges();
   if (index == 0) {
     key.T_world_base = now.T_world_base;
     graph_.add_vertex(key_vertex(0), now.T_world_base, true);
     // The drifting frontend starts where the key poses do: both are fixed there.
     if (drift_model_) graph_.add_vertex(key_vertex(0) + 1, now.T_world_base, true);
   } else {
-    // Link to the previous key pose: match against the last few key scans around the frontend's
-    // relative motion.
     const int prev = index - 1;
-    Pose2 motion = between(last_key_.T_world_base, now.T_world_base);
-    std::vector<Eigen::Vector2d> reference;
-    for (int j = std::max(0, index - config_.link_chain_length); j < index; ++j) {
-      scans_.append_world(j, key_poses_[j].T_world_base, reference);
-    }
-    std::vector<Eigen::Vector2d> query(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) query[i] = points[i].cast<double>();
-    MatchResult m = link_matcher_.match(reference, query, key_poses_[prev].T_world_base * motion);
-    // A frontend step the odometry contradicts: the scans decide. The link is matched around the
-    // odometry's step too, and the odometry's step replaces the frontend's only if the scans
-    // agree with it better (an odometry that slips or a log's restarted odometry must not
-    // replace a good frontend step).
-    std::optional<OdometryStep> odometry;
-    bool netted = false;
-    if (frontend) {
-      const auto [ca, cb] = frontend_covariances();
-      odometry = odometry_.check(last_key_.utime, now.utime, motion, ca + cb);
-      std::optional<OdometryStep> net;
-      if (odometry && odometry->frontend_rejected && step_before_from_odometry_) {
-        net = spike_net_step(now, *step_before_from_odometry_, ca + cb);
-      }
-      const Pose2& T_world_prev = key_poses_[prev].T_world_base;
-      if (net) {
-        // The frontend's last key pose was a spike: its two steps cancel, and their sum agrees
-        // with the odometry. The odometry placed that pose; this step takes the frontend's net.
-        const MatchResult mn = link_matcher_.match(reference, query, T_world_prev * net->motion);
-        if (mn.valid) m = mn;
-        motion = net->motion;
-        odometry = net;
-        netted = true;
-        ++counters_.frontend_spikes_netted;
-      } else if (odometry && odometry->frontend_rejected) {
-        const MatchResult mo =
-            link_matcher_.match(reference, query, T_world_prev * odometry->motion);
-        if (mo.valid && scans_side_with_odometry(
-                            *odometry, motion, ca + cb, between(T_world_prev, mo.T_world_query),
-                            rotate_covariance(mo.covariance, T_world_prev.rotation().transpose()),
-                            mo.raw_response, m.valid ? m.raw_response : 0.0,
-                            config_.odometry.max_frontend_chi2)) {
-          m = mo;
-          motion = odometry->motion;
-          ++counters_.frontend_steps_replaced;
-        } else {
-          odometry.reset();
-        }
-      } else {
-        odometry.reset();
-      }
-    }
-    Edge link;
-    link.from = key_vertex(prev);
-    link.to = key_vertex(index);
-    bool linked = false;
-    if (m.valid && m.raw_response >= config_.min_link_response) {
-      Pose2 T_world_key = m.T_world_query;
-      Eigen::Matrix3d covariance = m.covariance;  // world frame
-      if (config_.link_refine.enabled) {
-        const RefineResult r = link_refiner_.refine(reference, query, T_world_key);
-        if (r.valid) {
-          ++counters_.links_refined;
-          T_world_key = r.T_world_query;
-          if (!now.sparse && now.utime - last_key_.utime <= kMaxHeldLinkStepUs) {
-            hold_open_directions(r, last_key_.utime, now.utime, key_poses_[prev].T_world_base,
-                                 motion, T_world_key, covariance);
-          }
-        }
-      }
-      link.T_from_to = between(key_poses_[prev].T_world_base, T_world_key);
-      link.information = (config_.link_covariance_scale *
-                          rotate_covariance(covariance, T_world_key.rotation().transpose()))
-                             .inverse();
-      linked = true;
-      ++counters_.links_matched;
-    } else if (!frontend) {
-      ++counters_.links_fallback;
-      const double sxy = config_.fallback_sigma_xy_m, sth = config_.fallback_sigma_theta_rad;
-      link.T_from_to = motion;
-      link.information =
-          Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (sth * sth)).asDiagonal();
-      linked = true;
-    }
-    key.T_world_base = key_poses_[prev].T_world_base * (linked ? link.T_from_to : motion);
+    const KeyStep step = link_key(index, points, now);
+    key.T_world_base =
+        key_poses_[prev].T_world_base * (step.link ? step.link->T_from_to : step.motion);
     graph_.add_vertex(key_vertex(index), key.T_world_base);
     if (drift_model_) {
-      graph_.add_vertex(key_vertex(index) + 1, graph_.poses[key_vertex(prev) + 1] * motion);
+      graph_.add_vertex(key_vertex(index) + 1, graph_.poses[key_vertex(prev) + 1] * step.motion);
     }
-    if (linked) {
-      graph_.edges.push_back(link);
+    if (step.link) {
+      graph_.edges.push_back(*step.link);
       edge_kinds_.push_back(EdgeKind::kLink);
-      key_edges_.push_back({prev, index, EdgeKind::kLink, link.T_from_to, link.information});
+      key_edges_.push_back(
+          {prev, index, EdgeKind::kLink, step.link->T_from_to, step.link->information});
     }
-    if (frontend) add_frontend_edges(index, odometry);
+    if (frontend) add_frontend_edges(index, step.odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
     // A step netted over a spike is not the start of another.
     step_before_from_odometry_.reset();
-    if (odometry && !netted) step_before_from_odometry_ = odometry->motion;
+    if (step.odometry && !step.netted) step_before_from_odometry_ = step.odometry->motion;
   }
   scans_.add(std::move(points));
   key_poses_.push_back(key);
   key_before_last_ = last_key_;
   last_key_ = now;
-}
-
-std::optional<OdometryStep> Backend::spike_net_step(const PreparedPose& now,
-                                                    const Pose2& step_before,
-                                                    const Eigen::Matrix3d& step_covariance) const {
-  // The frontend's motion over both steps against the odometry's over the same interval, with
-  // both steps' frontend covariances.
-  const Pose2 frontend_net = between(key_before_last_.T_world_base, now.T_world_base);
-  const std::optional<OdometryStep> both =
-      odometry_.compare(key_before_last_.utime, now.utime, frontend_net, 2.0 * step_covariance);
-  if (!both || both->frontend_rejected) return std::nullopt;
-  OdometryStep step = *both;
-  step.motion = step_before.inverse() * frontend_net;
-  return step;
 }
 
 void Backend::add_closure(LoopClosure closure) {

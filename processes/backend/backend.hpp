@@ -301,6 +301,10 @@ class Backend {
  private:
   friend class BackendStateStore;  // backend_state.hpp: saves and restores the members below
   std::optional<BackendUpdate> take_pose(const PreparedPose& pose);
+  // Whether the frontend's relative motion enters the graph as edges of its own.
+  bool frontend_edges() const {
+    return config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
+  }
   // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
   // The frontend's covariances of the last key pose and the newest prepared pose, each in its own
@@ -316,12 +320,23 @@ class Backend {
   // stays replaced.
   std::optional<OdometryStep> spike_net_step(const PreparedPose& now, const Pose2& step_before,
                                              const Eigen::Matrix3d& step_covariance) const;
-  // A refined link of a scanner's stream along the directions its scans leave open
-  // (link_degeneracy_min_ratio): held
-  // at the odometry's step from `from_utime` to `to_utime` where that agrees with the frontend's
-  // motion, opened by the refiner's own information otherwise. T_world_key and covariance (world
-  // frame) are the link's, changed in place.
-  void hold_open_directions(const RefineResult& refined, int64_t from_utime, int64_t to_utime,
+  // The step from the last key pose to a new one (key_link.cpp).
+  struct KeyStep {
+    Pose2 motion;  // the frontend's relative motion, or the odometry's or the net that replaced it
+    std::optional<OdometryStep> odometry;  // the odometry's step where it replaced the frontend's
+    bool netted = false;                   // ... the frontend's net motion over a spike
+    std::optional<Edge> link;              // the link edge: matched, or the fallback
+  };
+  // The link of the new key pose `index` (its points in the base frame, its prepared pose
+  // `now`): matched against the last link_chain_length key scans, the frontend's step checked
+  // against the odometry, refined and held along open directions (key_link.cpp).
+  KeyStep link_key(int index, const std::vector<Eigen::Vector2f>& points, const PreparedPose& now);
+  // A refined link of a scanner's stream (a key step of at most half a second) along the
+  // directions its scans leave open (link_degeneracy_min_ratio): held at the odometry's step from
+  // the last key pose to `now` where that agrees with the frontend's motion, opened by the
+  // refiner's own information otherwise. T_world_key and covariance (world frame) are the link's,
+  // changed in place.
+  void hold_open_directions(const RefineResult& refined, const PreparedPose& now,
                             const Pose2& T_world_from, const Pose2& frontend_motion,
                             Pose2& T_world_key, Eigen::Matrix3d& covariance);
   // Adds the closure unless a trial optimisation finds it inconsistent with the graph.

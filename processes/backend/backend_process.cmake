@@ -6,7 +6,7 @@ add_library(traverse_backend_slam STATIC
   ${CMAKE_CURRENT_LIST_DIR}/scan_refiner.cpp ${CMAKE_CURRENT_LIST_DIR}/loop_closer.cpp
   ${CMAKE_CURRENT_LIST_DIR}/frontend_chain.cpp ${CMAKE_CURRENT_LIST_DIR}/odometry_check.cpp
   ${CMAKE_CURRENT_LIST_DIR}/boresight.cpp ${CMAKE_CURRENT_LIST_DIR}/start_frame.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/backend.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/backend.cpp ${CMAKE_CURRENT_LIST_DIR}/key_link.cpp
   ${CMAKE_CURRENT_LIST_DIR}/backend_state.cpp)
 target_link_libraries(traverse_backend_slam PUBLIC traverse_backend)
 

@@ -4,19 +4,9 @@
 #include <cmath>
 
 #include "config.hpp"
+#include "median.hpp"
 
 namespace traverse::backend {
-namespace {
-
-double median(std::vector<double> v) {
-  const std::size_t n = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(n), v.end());
-  if (v.size() % 2 == 1) return v[n];
-  const double upper = v[n];
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<long>(n)));
-}
-
-}  // namespace
 
 std::optional<std::string> validate(const StartFrameConfig& c) {
   ConfigCheck check;
@@ -63,11 +53,11 @@ void StartFrame::update(const std::vector<Pose2>& key_poses, const std::vector<d
     if (m.travel_m >= config_.min_travel_m) late.push_back(h);
   }
   if (late.empty()) return;
-  estimate_ = median(late);
-  early_estimate_ = early.empty() ? 0.0 : median(early);
+  estimate_ = *median(late);
+  early_estimate_ = median(early).value_or(0.0);
   std::vector<double> deviation;
   for (double v : late) deviation.push_back(std::abs(v - estimate_));
-  const double mad = median(deviation);
+  const double mad = *median(deviation);
   // A turn the grid gave the map at once (its first scans), not a drift that goes on.
   const bool at_once = !early.empty() && early_estimate_ * estimate_ > 0.0 &&
                        std::abs(early_estimate_) >= config_.min_early_share * std::abs(estimate_);
@@ -80,10 +70,8 @@ void StartFrame::update(const std::vector<Pose2>& key_poses, const std::vector<d
 
 Pose2 StartFrame::published(const Pose2& T_world_base, const Pose2& T_world_first) const {
   if (!heading_) return T_world_base;
-  const Eigen::Vector2d p =
-      T_world_first.translation() + Pose2(0.0, 0.0, -*heading_).rotation() *
-                                        (T_world_base.translation() - T_world_first.translation());
-  return Pose2(p.x(), p.y(), wrap_angle(T_world_base.theta() - *heading_));
+  // A turn by -h about the first key pose: positions about its position, headings by -h.
+  return T_world_first * Pose2(0.0, 0.0, -*heading_) * T_world_first.inverse() * T_world_base;
 }
 
 }  // namespace traverse::backend

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <limits>
 
+#include "median.hpp"
+
 namespace traverse::evaluator {
 
 void LoopClosureSet::add(const LoopClosure& closure) {
@@ -139,15 +141,6 @@ std::optional<Reach> nearest_relation(const LoopClosure& c, const std::vector<Re
   }
   if (!best_us) return std::nullopt;
   return reach;
-}
-
-// The median of `values` (the mean of the middle two for an even count); nullopt when empty.
-std::optional<double> median(std::vector<double> values) {
-  if (values.empty()) return std::nullopt;
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  if (values.size() % 2 == 1) return values[mid];
-  return 0.5 * (values[mid] + *std::max_element(values.begin(), values.begin() + mid));
 }
 
 }  // namespace
