@@ -93,11 +93,11 @@ convert_carmen_log() {
   fi
 }
 
-# True when $1 is missing or older than any of the other files.
+# True when $1 is missing, empty or older than any of the other files.
 stale() {
   local target="$1" f
   shift
-  [[ -e $target ]] || return 0
+  [[ -s $target ]] || return 0  # missing, or empty (a write that never finished)
   for f in "$@"; do
     [[ $f -nt $target ]] && return 0
   done

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # scripts/eval-coverage.sh [--fit] [--runs LIST] [--fit-runs LIST] [--keep-logs] [--profile P]
-#                          [--reuse-frontend] [--set PROCESS.KEY=VALUE ...] [--tag NAME]
+#                          [--reuse-frontend] [--wheel-encoders] [--set PROCESS.KEY=VALUE ...]
+#                          [--tag NAME]
 #
 # Does the annotator's 95 % bound hold? For each run (ROUTE:SEED on the realistic simulator
 # profile, or --profile ideal) the graph runs frontend, backend and annotator offline (scripts/eval-route.sh), and
@@ -24,6 +25,9 @@
 #   --reuse-frontend each run's frontend output comes from its offline frontend run (made once,
 #                    kept: scripts/eval-route.sh --reuse-frontend), so trying backend settings
 #                    costs the backend's and annotator's time only
+#   --wheel-encoders the simulated cart's wheel odometry in every run (scripts/eval-route.sh
+#                    --wheel-encoders; the runs are named ROUTE-seedN-wheels): the corridor route
+#                    needs it, its bare corridors lose the frontend without it
 #   --set P.K=V, --tag NAME  as scripts/eval-route.sh's: the graph with a config key changed, its
 #                    runs in folders named with the tag
 # A run whose compact log exists is not run again (delete its folder to rerun it).
@@ -31,7 +35,7 @@ set -euo pipefail
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
-fit="" keep="" reuse="" profile=realistic tag="" sets=() fit_runs="court-loop:1,office-s1:1"
+fit="" keep="" reuse="" wheels="" profile=realistic tag="" sets=() fit_runs="court-loop:1,office-s1:1"
 runs=""
 held_out="court-loop:2,court-loop:3,corridor-return:1,office-s2:1,office-s3:2"
 while (($#)); do
@@ -42,6 +46,7 @@ while (($#)); do
     --keep-logs) keep=1; shift ;;
     --profile) profile="${2:?--profile needs ideal or realistic}"; shift 2 ;;
     --reuse-frontend) reuse=1; shift ;;
+    --wheel-encoders) wheels=1; shift ;;
     --set) sets+=(--set "${2:?--set needs PROCESS.KEY=VALUE}"); shift 2 ;;
     --tag) tag="${2:?--tag needs a name}"; shift 2 ;;
     -h | --help) usage 0 ;;
@@ -56,7 +61,7 @@ config="$ROOT/configs/annotator.yaml"
 stages="frontend,backend,annotator"
 
 run_dir() {  # ROUTE SEED
-  echo "$ROOT/out/eval/$1-seed$2-$profile-noprofiles-$(stages_tag "$stages")${tag:+-$tag}"
+  echo "$ROOT/out/eval/$1-seed$2-$profile${wheels:+-wheels}-noprofiles-$(stages_tag "$stages")${tag:+-$tag}"
 }
 
 # The run's compact log, running the graph first when there is none.
@@ -67,7 +72,7 @@ ensure_run() {  # ROUTE SEED
   if [[ ! -s $dir/run.lcmlog ]]; then
     echo "eval-coverage: running $route seed $seed ($stages, offline)" >&2
     "$ROOT/scripts/eval-route.sh" "$route" --seed "$seed" --stages "$stages" --offline \
-      --profile "$profile" ${reuse:+--reuse-frontend} "${sets[@]}" ${tag:+--tag "$tag"} \
+      --profile "$profile" ${reuse:+--reuse-frontend} ${wheels:+--wheel-encoders} "${sets[@]}" ${tag:+--tag "$tag"} \
       >"$dir.route.out" 2>&1 || { tail -n 5 "$dir.route.out" >&2; die "eval-route failed for $route seed $seed"; }
   fi
   "$BIN/traverse-annotator-eval" --log "$dir/run.lcmlog" --compact "$dir/coverage.lcmlog.tmp" \
@@ -127,7 +132,7 @@ for rs in "${all_runs[@]}"; do
   route="${rs%%:*}" seed="${rs##*:}"
   ensure_run "$route" "$seed"
   evaluate_run "$route" "$seed"
-  names+=("$route-seed$seed")
+  names+=("$route-seed$seed${wheels:+-wheels}")
   files+=("$(run_dir "$route" "$seed")/coverage.json")
   [[ ,$fit_runs, == *,$rs,* ]] && fitted+=(true) || fitted+=(false)
 done

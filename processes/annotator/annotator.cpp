@@ -57,12 +57,21 @@ void Annotator::set_key_pose(int64_t id, int64_t utime, const Pose2& T_world_bas
 
 bool Annotator::add_edge(int index, int64_t from_id, int64_t to_id, const Pose2& T_from_to,
                          const Eigen::Matrix3d& information) {
-  if (index < static_cast<int>(edges_.size())) return true;  // a repeat: already held
-  if (index > static_cast<int>(edges_.size())) {
-    counters_.edge_gaps += index - static_cast<long>(edges_.size());
+  if (index < next_edge_index_) return true;  // a repeat: already taken (or already refused)
+  if (index > next_edge_index_) {
+    counters_.edge_gaps += index - next_edge_index_;
     return false;
   }
-  if (from_id < 0 || to_id < 0 || from_id == to_id || !backend::positive_definite(information)) {
+  // The edge's place is taken either way: one refused edge must not hold back every later one.
+  ++next_edge_index_;
+  // An information matrix made by inverting a covariance is symmetric only to rounding (1e-12 of
+  // its norm, e.g. 1e-6 beside a 1e6 heading term); that part is dropped, anything more refused.
+  const Eigen::Matrix3d symmetric = 0.5 * (information + information.transpose());
+  const bool rounding_only = information.allFinite() &&
+                             (information - information.transpose()).norm() <=
+                                 kSymmetryTolerance * symmetric.norm();
+  if (from_id < 0 || to_id < 0 || from_id == to_id || !rounding_only ||
+      !backend::positive_definite(symmetric)) {
     ++counters_.edges_rejected;
     return false;
   }
@@ -70,7 +79,7 @@ bool Annotator::add_edge(int index, int64_t from_id, int64_t to_id, const Pose2&
   e.from = static_cast<int>(from_id);
   e.to = static_cast<int>(to_id);
   e.T_from_to = T_from_to;
-  e.information = information;
+  e.information = symmetric;
   edges_.push_back(e);
   counters_.edges = static_cast<long>(edges_.size());
   return true;

@@ -85,6 +85,9 @@ struct AnnotatorCounters {
 
 class Annotator {
  public:
+  // How far from symmetric an edge's information may be, relative to its norm (rounding of an
+  // inverse; Eigen's isApprox would refuse 1e-12).
+  static constexpr double kSymmetryTolerance = 1e-9;
   // The config must pass validate().
   explicit Annotator(const AnnotatorConfig& config);
 
@@ -92,7 +95,9 @@ class Annotator {
   void set_key_pose(int64_t id, int64_t utime, const Pose2& T_world_base,
                     const Eigen::Matrix3d& covariance);
   // A pose-graph edge as published on POSE_GRAPH_EDGES; edges arrive in index order. False (and
-  // counted) when it is not positive definite or its index is not the next one.
+  // counted) when it is not positive definite, not symmetric beyond rounding
+  // (kSymmetryTolerance of its norm), or its index is not the next one. A refused edge still takes
+  // its index: the edges after it are taken, the graph goes without it.
   bool add_edge(int index, int64_t from_id, int64_t to_id, const Pose2& T_from_to,
                 const Eigen::Matrix3d& information);
   // Recomputes the key poses set since the last call and returns the annotations that are new or
@@ -128,6 +133,7 @@ class Annotator {
   Legend legend_;
   std::map<int64_t, Key> keys_;  // by id
   std::vector<backend::Edge> edges_;
+  int next_edge_index_ = 0;  // index of the next edge on POSE_GRAPH_EDGES (taken or refused)
   std::vector<int64_t> dirty_;  // ids set since the last update
   std::map<int64_t, Annotation> published_;
   JointCovariance joint_;

@@ -83,9 +83,13 @@ Backend::KeyStep Backend::link_key(int index, const std::vector<Eigen::Vector2f>
       }
     }
     link.T_from_to = between(T_world_prev, T_world_key);
-    link.information = (config_.link_covariance_scale *
-                        rotate_covariance(covariance, T_world_key.rotation().transpose()))
-                           .inverse();
+    const Eigen::Matrix3d information =
+        (config_.link_covariance_scale *
+         rotate_covariance(covariance, T_world_key.rotation().transpose()))
+            .inverse();
+    // Symmetric as published: the inverse of a covariance as ill-conditioned as a held link's
+    // (1e-2 along a corridor, 1e-6 in heading) is symmetric only to rounding.
+    link.information = 0.5 * (information + information.transpose());
     step.link = link;
     ++counters_.links_matched;
   } else if (!frontend) {

@@ -134,6 +134,22 @@ TEST(Annotator, BadAndMissingEdgesAreCounted) {
   EXPECT_FALSE(a.add_edge(1, 1, 2, Pose2(1, 0, 0), bad));
   EXPECT_EQ(a.counters().edges_rejected, 1);
   EXPECT_EQ(a.counters().edges, 1);
+  // The refused edge took its index: the next one is taken, not counted as missed.
+  EXPECT_TRUE(a.add_edge(2, 1, 2, Pose2(1, 0, 0), good));
+  EXPECT_EQ(a.counters().edges, 2);
+  EXPECT_EQ(a.counters().edge_gaps, 2);
+  // A held link's information as the backend inverted it: terms from 0.1 to 1e6, off the
+  // diagonal asymmetric by 1e-6 (rounding, 1e-12 of its norm) is taken; by 1 % it is refused.
+  Eigen::Matrix3d held;
+  held << 0.1, 2.0, 30.0, 2.0, 5e4, 40.0, 30.0, 40.0, 1e6;
+  held(0, 2) += 1.1e-6;
+  EXPECT_TRUE(a.add_edge(3, 2, 3, Pose2(1, 0, 0), held));
+  EXPECT_EQ(a.counters().edges, 3);
+  Eigen::Matrix3d skewed = held;
+  skewed(1, 2) *= 1.5;
+  skewed(1, 2) += 0.01 * held.norm();
+  EXPECT_FALSE(a.add_edge(4, 3, 4, Pose2(1, 0, 0), skewed));
+  EXPECT_EQ(a.counters().edges_rejected, 2);
 }
 
 TEST(Annotator, ConfigValidationNamesTheKey) {
