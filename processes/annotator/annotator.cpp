@@ -64,14 +64,8 @@ bool Annotator::add_edge(int index, int64_t from_id, int64_t to_id, const Pose2&
   }
   // The edge's place is taken either way: one refused edge must not hold back every later one.
   ++next_edge_index_;
-  // An information matrix made by inverting a covariance is symmetric only to rounding (1e-12 of
-  // its norm, e.g. 1e-6 beside a 1e6 heading term); that part is dropped, anything more refused.
-  const Eigen::Matrix3d symmetric = 0.5 * (information + information.transpose());
-  const bool rounding_only = information.allFinite() &&
-                             (information - information.transpose()).norm() <=
-                                 kSymmetryTolerance * symmetric.norm();
-  if (from_id < 0 || to_id < 0 || from_id == to_id || !rounding_only ||
-      !backend::positive_definite(symmetric)) {
+  const std::optional<Eigen::Matrix3d> usable = backend::usable_information(information);
+  if (from_id < 0 || to_id < 0 || from_id == to_id || !usable) {
     ++counters_.edges_rejected;
     return false;
   }
@@ -79,7 +73,7 @@ bool Annotator::add_edge(int index, int64_t from_id, int64_t to_id, const Pose2&
   e.from = static_cast<int>(from_id);
   e.to = static_cast<int>(to_id);
   e.T_from_to = T_from_to;
-  e.information = symmetric;
+  e.information = *usable;
   edges_.push_back(e);
   counters_.edges = static_cast<long>(edges_.size());
   return true;

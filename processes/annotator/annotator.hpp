@@ -85,9 +85,6 @@ struct AnnotatorCounters {
 
 class Annotator {
  public:
-  // How far from symmetric an edge's information may be, relative to its norm (rounding of an
-  // inverse; Eigen's isApprox would refuse 1e-12).
-  static constexpr double kSymmetryTolerance = 1e-9;
   // The config must pass validate().
   explicit Annotator(const AnnotatorConfig& config);
 
@@ -96,7 +93,7 @@ class Annotator {
                     const Eigen::Matrix3d& covariance);
   // A pose-graph edge as published on POSE_GRAPH_EDGES; edges arrive in index order. False (and
   // counted) when it is not positive definite, not symmetric beyond rounding
-  // (kSymmetryTolerance of its norm), or its index is not the next one. A refused edge still takes
+  // (backend::usable_information), or its index is not the next one. A refused edge still takes
   // its index: the edges after it are taken, the graph goes without it.
   bool add_edge(int index, int64_t from_id, int64_t to_id, const Pose2& T_from_to,
                 const Eigen::Matrix3d& information);

@@ -91,10 +91,18 @@ void initialise_from_edges(PoseGraph& graph) {
   });
 }
 
+std::optional<Eigen::Matrix3d> usable_information(const Eigen::Matrix3d& information) {
+  if (!information.allFinite()) return std::nullopt;
+  const Eigen::Matrix3d symmetric = 0.5 * (information + information.transpose());
+  if ((information - information.transpose()).norm() > kSymmetryTolerance * symmetric.norm()) {
+    return std::nullopt;
+  }
+  if (Eigen::LLT<Eigen::Matrix3d>(symmetric).info() != Eigen::Success) return std::nullopt;
+  return symmetric;
+}
+
 bool positive_definite(const Eigen::Matrix3d& information) {
-  if (!information.allFinite() || !information.isApprox(information.transpose())) return false;
-  Eigen::LLT<Eigen::Matrix3d> llt(information);
-  return llt.info() == Eigen::Success;
+  return usable_information(information).has_value();
 }
 
 Eigen::Vector3d edge_error(const Pose2& T_world_i, const Pose2& T_world_j, const Pose2& Z) {

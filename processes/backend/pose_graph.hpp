@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "se2.hpp"
@@ -49,7 +50,15 @@ std::vector<int> components(const PoseGraph& graph, int* count = nullptr);
 // by its edges alone.
 void initialise_from_edges(PoseGraph& graph);
 
-// True when a 3x3 information matrix is symmetric positive definite (its Cholesky exists).
+// How far from symmetric an information matrix may be, relative to its norm: the rounding of an
+// inverse (a held link's, 0.1 to 1e6, is off by 1e-6, which Eigen's isApprox would refuse).
+inline constexpr double kSymmetryTolerance = 1e-9;
+
+// A 3x3 information matrix as used: its symmetric part, when it is finite, symmetric up to
+// kSymmetryTolerance and positive definite (its Cholesky exists); nullopt otherwise.
+std::optional<Eigen::Matrix3d> usable_information(const Eigen::Matrix3d& information);
+
+// True when usable_information(information) has a value.
 bool positive_definite(const Eigen::Matrix3d& information);
 
 // e = t2v(Z^-1 (Xi^-1 Xj)) of one edge, given the two vertex poses.

@@ -73,7 +73,10 @@ bool PreviewResend::poll() {
   }
   const auto t0 = std::chrono::steady_clock::now();
   merge(pass_.get());
+  // What arrived during the pass may have filled the store again, and add() may not come again
+  // (the end of a route): the next pass starts now rather than with the next point.
   count_blocked(seconds_since(t0));
+  if (bytes() > max_bytes_) start_pass();  // counts its own hold-up
   return true;
 }
 

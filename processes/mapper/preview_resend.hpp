@@ -54,7 +54,8 @@ class PreviewResend {
 
   // A profile's preview points as sent live (parts of one profile, same utime, are merged).
   void add(const PreviewProfile& profile);
-  // Merges a background pass that has finished; true when there was one.
+  // Merges a background pass that has finished, and starts the next when what arrived meanwhile
+  // put the store over its cap; true when there was one.
   bool poll();
   // Waits for a background pass under way, if any, merges it, and passes again while the store is
   // over its cap (not counted as blocked: the node never waits; the end of a bench or test does).
