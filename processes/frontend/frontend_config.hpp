@@ -65,6 +65,12 @@ struct MatcherConfig {
   // below: 7.8 m RMSE). Off by default with the two keys below (docs/frontends.md, "The
   // spread").
   bool normal_projection = false;
+  // Not a key: Gauss-Newton reads the map at the hits' sub-cell offsets (map.subcell_hits;
+  // OccupancyGrid::value's `at_hits`). The frontend sets it per scan: on for a scanner's stream,
+  // off for a log subsampled by travel, whose wide search lands metres from the last pose and
+  // whose Gauss-Newton then takes poor fits near the search's candidates on the sub-cell map
+  // (docs/frontends.md, "Sub-cell hits": the subsampled CARMEN aces log lost with it).
+  bool read_at_hits = true;
   // Degeneracy (hector/degeneracy.hpp): eigen-directions of the scan's information (heading
   // weighed as the arc it moves the points through) below this share of the largest are held at
   // the odometry prediction, and take the prediction's covariance. 0 never holds any.

@@ -63,7 +63,7 @@ bool MotionModel::imu_covers(int64_t from, int64_t to) const {
 }
 
 bool MotionModel::subsampled_by_travel(int64_t gap_us) const {
-  return state_.recent_intervals_us.size() == 5 &&
+  return pace_known() &&
          state_.recent_intervals_us.percentile(50) > static_cast<double>(gap_us);
 }
 

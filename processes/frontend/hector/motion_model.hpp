@@ -67,6 +67,8 @@ class MotionModel {
   // The median of the last five intervals between poses exceeds gap_us: scans come further apart
   // than any scanner's period, a log subsampled by travel.
   bool subsampled_by_travel(int64_t gap_us) const;
+  // Five intervals between poses seen: subsampled_by_travel() can tell.
+  bool pace_known() const { return state_.recent_intervals_us.size() == 5; }
 
   // The pose at `utime` (after the last pose), see the header. use_imu: imu_covers() from the
   // last pose to utime; sparse: the scan is a sparse one.

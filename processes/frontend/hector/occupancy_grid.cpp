@@ -77,26 +77,19 @@ OccupancyGrid::Corner OccupancyGrid::corner(const Eigen::Vector2d& p_map) const 
   return {static_cast<int64_t>(fx0), static_cast<int64_t>(fy0), gx - fx0, gy - fy0};
 }
 
-double OccupancyGrid::value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient) const {
-  if (!subcell_) return interpolate(p_map, gradient);
-  Eigen::Matrix2d d_offset;
-  const Eigen::Vector2d offset = hit_offset(p_map, gradient ? &d_offset : nullptr);
-  const double m = interpolate(p_map - offset, gradient);
-  // Chain rule: d M(p - o(p)) / dp = (I - do/dp)^T grad M.
-  if (gradient) *gradient = (Eigen::Matrix2d::Identity() - d_offset).transpose() * *gradient;
-  return m;
+double OccupancyGrid::value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient,
+                            bool at_hits) const {
+  if (!subcell_ || !at_hits) return interpolate(p_map, gradient);
+  return interpolate(p_map - hit_offset(p_map), gradient);
 }
 
-Eigen::Vector2d OccupancyGrid::hit_offset(const Eigen::Vector2d& p_map,
-                                          Eigen::Matrix2d* jacobian) const {
-  if (jacobian) jacobian->setZero();
+Eigen::Vector2d OccupancyGrid::hit_offset(const Eigen::Vector2d& p_map) const {
   if (!subcell_) return Eigen::Vector2d::Zero();
   const auto [x0, y0, fx, fy] = corner(p_map);
   // Each of the four cells weighs by its bilinear weight times its occupied evidence (probability
-  // above 0.5): free and unknown cells say nothing about where a wall lies. The weighted sum of
-  // the offsets S and of the weights W, and their derivatives by fx and fy, give o = S / W.
-  Eigen::Vector2d sum = Eigen::Vector2d::Zero(), dsum_dfx = sum, dsum_dfy = sum;
-  double weight = 0.0, dweight_dfx = 0.0, dweight_dfy = 0.0;
+  // above 0.5): free and unknown cells say nothing about where a wall lies.
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  double weight = 0.0;
   const bool one_tile = in_one_tile(x0, y0);  // the usual case: one look-up
   const Tile* tile = one_tile ? find_tile(floor_div_tile(x0), floor_div_tile(y0)) : nullptr;
   if (one_tile && !tile) return Eigen::Vector2d::Zero();
@@ -108,27 +101,13 @@ Eigen::Vector2d OccupancyGrid::hit_offset(const Eigen::Vector2d& p_map,
       const int64_t i = in_tile(iy) * kTileSize + in_tile(ix);
       const double evidence = probability_of_[t->log_odds[i] + 128] - 0.5;
       if (evidence <= 0.0 || t->subcell[i].count == 0) continue;
-      const double wx = dx ? fx : 1.0 - fx, wy = dy ? fy : 1.0 - fy;
-      const double dwx = dx ? 1.0 : -1.0, dwy = dy ? 1.0 : -1.0;
-      const Eigen::Vector2d o(t->subcell[i].x, t->subcell[i].y);
-      weight += wx * wy * evidence;
-      dweight_dfx += dwx * wy * evidence;
-      dweight_dfy += wx * dwy * evidence;
-      sum += wx * wy * evidence * o;
-      dsum_dfx += dwx * wy * evidence * o;
-      dsum_dfy += wx * dwy * evidence * o;
+      const double w = (dx ? fx : 1.0 - fx) * (dy ? fy : 1.0 - fy) * evidence;
+      weight += w;
+      sum += w * Eigen::Vector2d(t->subcell[i].x, t->subcell[i].y);
     }
   }
   if (weight <= 0.0) return Eigen::Vector2d::Zero();
-  const double scale = resolution_m_ / kOffsetSteps;  // offset steps -> m
-  if (jacobian) {
-    // d(S/W)/df = (dS/df W - S dW/df) / W^2; f = p / resolution.
-    jacobian->col(0) =
-        (dsum_dfx * weight - sum * dweight_dfx) * (scale / (weight * weight * resolution_m_));
-    jacobian->col(1) =
-        (dsum_dfy * weight - sum * dweight_dfy) * (scale / (weight * weight * resolution_m_));
-  }
-  return sum * (scale / weight);
+  return sum * (resolution_m_ / kOffsetSteps / weight);  // offset steps -> m
 }
 
 void OccupancyGrid::add_hit_offset(SubcellHits& h, const Eigen::Vector2d& cell_offset) {

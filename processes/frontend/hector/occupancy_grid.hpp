@@ -41,13 +41,17 @@ class OccupancyGrid {
   double cell_probability(int64_t ix, int64_t iy) const;
 
   // M(p) by bilinear interpolation (eq. 4) and, if `gradient` is given, dM/dp [1/m] (eq. 5-6).
-  // With sub-cell hits, M(p - o(p)) with o the hits' offset from the cell centres near p, and its
-  // gradient (I - do/dp)^T grad M.
-  double value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient = nullptr) const;
+  // With sub-cell hits and `at_hits`, M(p - o(p)) with o the hits' offset from the cell centres
+  // near p, and as its gradient grad M at p - o(p): the offset held, its own variation left out.
+  // That variation is the jumps of the hits' means from one cell to the next (noise of a few
+  // millimetres over a 5 cm cell), and carried into Gauss-Newton it makes the steps wander: on the
+  // relations benchmark's intel log the frontend slid 2.4 m at 669 s with it, and holds with it
+  // left out (docs/frontends.md, "Sub-cell hits"). Without `at_hits` the plain map is read.
+  double value(const Eigen::Vector2d& p_map, Eigen::Vector2d* gradient = nullptr,
+               bool at_hits = true) const;
   // The offset o(p) of the hits near p from their cells' centres [m] (zero without sub-cell hits
-  // or where no cell near p is more likely occupied than not), and if asked do/dp.
-  Eigen::Vector2d hit_offset(const Eigen::Vector2d& p_map,
-                             Eigen::Matrix2d* jacobian = nullptr) const;
+  // or where no cell near p is more likely occupied than not).
+  Eigen::Vector2d hit_offset(const Eigen::Vector2d& p_map) const;
 
   // Integrates one scan seen from `origin_map`: cells on each ray become more likely free, the end
   // point's cell more likely occupied. Each cell is updated at most once per call and a hit wins

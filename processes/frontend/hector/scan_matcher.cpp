@@ -16,7 +16,8 @@ namespace traverse::frontend {
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
                                  const Pose2& T_map_base,
-                                 const std::vector<Eigen::Vector2d>* normals_base) {
+                                 const std::vector<Eigen::Vector2d>* normals_base,
+                                 bool at_hits) {
   NormalEquations ne;
   const Eigen::Matrix2d R = T_map_base.rotation();
   const double c = R(0, 0), s = R(1, 0);
@@ -24,7 +25,7 @@ NormalEquations normal_equations(const OccupancyGrid& grid,
   for (std::size_t i = 0; i < points_base.size(); ++i) {
     const Eigen::Vector2d& p = points_base[i];
     const Eigen::Vector2d q = R * p + T_map_base.translation();  // S_i(xi), eq. 7
-    const double r = 1.0 - grid.value(q, &grad);
+    const double r = 1.0 - grid.value(q, &grad, at_hits);
     if (normals_base && !(*normals_base)[i].isZero()) {
       // Only the gradient across the point's surface (surface_normals.hpp).
       const Eigen::Vector2d n = R * (*normals_base)[i];
@@ -93,7 +94,8 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
     for (int it = 0; it < iterations; ++it) {
       const Pose2 T(xi.x(), xi.y(), xi.z());
       const NormalEquations ne =
-          normal_equations(grid, points_base, T, config.normal_projection ? normals : nullptr);
+          normal_equations(grid, points_base, T, config.normal_projection ? normals : nullptr,
+                           config.read_at_hits);
       if (it == 0) var = std::max(min_var, ne.cost / dof);
       const Eigen::Vector3d e = prior_error(xi);
       const double cost = ne.cost / var + e.dot(P * e);
@@ -125,13 +127,13 @@ MatchResult refine(const MapPyramid& maps, const std::vector<Eigen::Vector2d>& p
   // whole gradient's pulls along the walls (the map's history) blur it.
   const OccupancyGrid& finest = maps.level(last_level);
   const Pose2 T(xi.x(), xi.y(), xi.z());
-  const NormalEquations ne = normal_equations(finest, points_base, T);
+  const NormalEquations ne = normal_equations(finest, points_base, T, nullptr, config.read_at_hits);
   const double var = std::max(min_var, ne.cost / dof);
   const int cells = std::max(1, distinct_cells(finest, points_base, T));
   const double points_per_cell = std::max(1.0, static_cast<double>(ne.n) / cells);
   result.covariance = (ne.H / (var * points_per_cell) + P).inverse();
   const Eigen::Matrix3d H_matched =
-      normals ? normal_equations(finest, points_base, T, normals).H : ne.H;
+      normals ? normal_equations(finest, points_base, T, normals, config.read_at_hits).H : ne.H;
   result.information = H_matched / (var * points_per_cell);
   result.covariance = 0.5 * (result.covariance + result.covariance.transpose()).eval();
   result.T_map_base = T;

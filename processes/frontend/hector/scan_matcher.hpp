@@ -54,11 +54,12 @@ struct NormalEquations {
   int n = 0;
 };
 // With normals (base frame, one per point; zero: none), each point's map gradient is taken only
-// along its normal (surface_normals.hpp).
+// along its normal (surface_normals.hpp). `at_hits`: OccupancyGrid::value's.
 NormalEquations normal_equations(const OccupancyGrid& grid,
                                  const std::vector<Eigen::Vector2d>& points_base,
                                  const Pose2& T_map_base,
-                                 const std::vector<Eigen::Vector2d>* normals_base = nullptr);
+                                 const std::vector<Eigen::Vector2d>* normals_base = nullptr,
+                                 bool at_hits = true);
 
 // Wide search around priors[0] (not empty) on pyramid level min(1, levels - 1) with a motion
 // prior towards the nearest of `priors`, then Gauss-Newton over all levels from the best pose,
