@@ -326,9 +326,9 @@ class Backend {
     Pose2 motion;  // the frontend's relative motion, or the odometry's or the net that replaced it
     std::optional<OdometryStep> odometry;  // the odometry's step where it replaced the frontend's
     bool netted = false;                   // ... the frontend's net motion over a spike
-    // Where the odometry's step replaced the frontend's: e e^T of the two steps' difference e (x,
-    // y [m], theta [rad], in the first pose's frame), added to the covariance of both edges the
-    // step gives (key_link.cpp says why); zero otherwise.
+    // Where the odometry's step replaced the frontend's: diag(|e_xy|^2, |e_xy|^2, e_theta^2) of
+    // the two steps' difference e (x, y [m], theta [rad], in the first pose's frame), added to the
+    // covariance of both edges the step gives (key_link.cpp says why); zero otherwise.
     Eigen::Matrix3d disagreement = Eigen::Matrix3d::Zero();
     std::optional<Edge> link;              // the link edge: matched, or the fallback
   };
