@@ -153,8 +153,7 @@ std::pair<Eigen::Matrix3d, Eigen::Matrix3d> Backend::frontend_covariances() cons
   return {covariance(a), cb};
 }
 
-void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odometry,
-                                 const Eigen::Matrix3d& disagreement) {
+void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odometry) {
   const PreparedPose& a = last_key_;
   const PreparedPose& b = since_key_.back();
   const auto [ca, cb] = frontend_covariances();
@@ -166,7 +165,7 @@ void Backend::add_frontend_edges(int key, const std::optional<OdometryStep>& odo
     edge.from = from;
     edge.to = to;
     edge.T_from_to = odometry->motion;
-    edge.information = (odometry->covariance + disagreement).inverse();
+    edge.information = odometry->covariance.inverse();
     graph_.edges.push_back(edge);
     edge_kinds_.push_back(drift_model_ ? EdgeKind::kFrontendDrift : EdgeKind::kFrontend);
     step = edge;
@@ -232,7 +231,7 @@ void Backend::add_key_pose(const PlanarScan& scan) {
       key_edges_.push_back(
           {prev, index, EdgeKind::kLink, step.link->T_from_to, step.link->information});
     }
-    if (frontend) add_frontend_edges(index, step.odometry, step.disagreement);
+    if (frontend) add_frontend_edges(index, step.odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
     // A step netted over a spike is not the start of another.
     step_before_from_odometry_.reset();

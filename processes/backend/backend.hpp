@@ -312,8 +312,7 @@ class Backend {
   std::pair<Eigen::Matrix3d, Eigen::Matrix3d> frontend_covariances() const;
   // Adds the frontend's edges of the new key pose `key` (frontend_chain.hpp); `odometry`: the
   // odometry's step when it rejected the frontend's, which then takes its place.
-  void add_frontend_edges(int key, const std::optional<OdometryStep>& odometry,
-                          const Eigen::Matrix3d& disagreement);
+  void add_frontend_edges(int key, const std::optional<OdometryStep>& odometry);
   // After the odometry replaced the last key step (`step_before`) and contradicts this one too:
   // the frontend's net motion over both, as this step's (step_before^-1 * net), when that net
   // agrees with the odometry's over the same interval; nullopt otherwise. A frontend that places
@@ -324,12 +323,10 @@ class Backend {
   // The step from the last key pose to a new one (key_link.cpp).
   struct KeyStep {
     Pose2 motion;  // the frontend's relative motion, or the odometry's or the net that replaced it
-    std::optional<OdometryStep> odometry;  // the odometry's step where it replaced the frontend's
-    bool netted = false;                   // ... the frontend's net motion over a spike
-    // Where the odometry's step replaced the frontend's: diag(|e_xy|^2, |e_xy|^2, e_theta^2) of
-    // the two steps' difference e (x, y [m], theta [rad], in the first pose's frame), added to the
-    // covariance of both edges the step gives (key_link.cpp says why); zero otherwise.
-    Eigen::Matrix3d disagreement = Eigen::Matrix3d::Zero();
+    // The odometry's step where it replaced the frontend's, its covariance widened by the two
+    // steps' disagreement (key_link.cpp says why).
+    std::optional<OdometryStep> odometry;
+    bool netted = false;  // ... the frontend's net motion over a spike
     std::optional<Edge> link;              // the link edge: matched, or the fallback
   };
   // The link of the new key pose `index` (its points in the base frame, its prepared pose

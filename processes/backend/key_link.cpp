@@ -33,6 +33,10 @@ Backend::KeyStep Backend::link_key(int index, const std::vector<Eigen::Vector2f>
   std::vector<Eigen::Vector2d> query(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) query[i] = points[i].cast<double>();
   MatchResult m = link_matcher_.match(reference, query, T_world_prev * step.motion);
+  // Where the odometry's step replaces the frontend's: diag(|e_xy|^2, |e_xy|^2, e_theta^2) of the
+  // two steps' difference e (first pose's frame), added to the covariance of the link and of the
+  // odometry's edge (below).
+  Eigen::Matrix3d disagreement = Eigen::Matrix3d::Zero();
   // A frontend step the odometry contradicts: the scans decide. The link is matched around the
   // odometry's step too, and the odometry's step replaces the frontend's only if the scans
   // agree with it better (an odometry that slips or a log's restarted odometry must not
@@ -74,10 +78,11 @@ Backend::KeyStep Backend::link_key(int index, const std::vector<Eigen::Vector2f>
         Eigen::Vector3d e = (step.motion.vector() - odometry->motion.vector());
         e.z() = wrap_angle(e.z());
         const double exy2 = e.head<2>().squaredNorm();
-        step.disagreement = Eigen::Vector3d(exy2, exy2, e.z() * e.z()).asDiagonal();
+        disagreement = Eigen::Vector3d(exy2, exy2, e.z() * e.z()).asDiagonal();
         m = mo;
         step.motion = odometry->motion;
         step.odometry = odometry;
+        step.odometry->covariance += disagreement;
         ++counters_.frontend_steps_replaced;
       }
     }
@@ -99,7 +104,7 @@ Backend::KeyStep Backend::link_key(int index, const std::vector<Eigen::Vector2f>
     link.T_from_to = between(T_world_prev, T_world_key);
     const Eigen::Matrix3d information =
         (rotate_covariance(config_.link_covariance_scale * covariance +
-                               rotate_covariance(step.disagreement, T_world_prev.rotation()),
+                               rotate_covariance(disagreement, T_world_prev.rotation()),
                            T_world_key.rotation().transpose()))
             .inverse();
     // Symmetric as published: the inverse of a covariance as ill-conditioned as a held link's
