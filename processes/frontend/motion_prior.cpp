@@ -39,10 +39,10 @@ std::optional<MotionPrior::At> MotionPrior::at(int64_t t, OdometryMiss* miss) co
   if (t >= last.utime) {
     if (t == last.utime) return At{last.T_odom_base, last.pose_covariance};
     if (t - last.utime > config_.odometry_max_extrapolation_us) return fail(OdometryMiss::kStale);
-    // The newest rate carried on: the increment since the newest sample at least as far before
-    // it as t is after it, scaled to the time past the newest sample. Never the last increment
-    // alone: a logger that stamps on arrival bunches samples a millisecond apart, and one such
-    // increment carried 90 ms on is a step of metres (intel: 2.2 m, the frontend lost).
+    // The newest rate carried on: the increment to the newest sample from the latest one at least
+    // as far before it as t is after it, scaled to the time past the newest sample. Never the last
+    // increment alone: a logger that stamps on arrival bunches samples a millisecond apart, and
+    // one such increment carried 90 ms on is a step of metres (intel: 2.2 m, the frontend lost).
     std::size_t i = samples_.size() - 1;
     while (i > 0 && last.utime - samples_[i].utime < t - last.utime) {
       if (samples_[i].utime - samples_[i - 1].utime > config_.odometry_max_gap_us)
