@@ -93,6 +93,12 @@ void BackendNode::on_scan(const planar_scan_t& msg) { backend_.add_scan(to_plana
 
 void BackendNode::on_pose(const pose2d_t& msg) {
   if (!std::isfinite(msg.x) || !std::isfinite(msg.y) || !std::isfinite(msg.theta)) return;
+  // A scan stamped late: its pose is not the base's at its stamp, and the steps to it and from
+  // it are no motion (the key poses follow the trajectory in time).
+  if (msg.flags & pose2d_t::FLAG_LATE) {
+    ++poses_late_;
+    return;
+  }
   Eigen::Matrix3d covariance;
   for (int i = 0; i < 9; ++i) covariance(i / 3, i % 3) = msg.covariance[i];
   if (auto update = backend_.add_pose(msg.utime, Pose2(msg.x, msg.y, msg.theta), covariance)) {
@@ -258,6 +264,7 @@ void BackendNode::report_counters() {
   const LoopCloserCounters& l = backend_.loop_counters();
   counters_("poses_received", static_cast<double>(c.prep.poses));
   counters_("poses_out_of_order", static_cast<double>(c.prep.out_of_order));
+  counters_("poses_late", static_cast<double>(poses_late_));
   counters_("poses_sparse", static_cast<double>(c.prep.sparse_poses));
   counters_("scans_received", static_cast<double>(c.scans));
   counters_("jumps_smoothed", static_cast<double>(c.prep.jumps_smoothed));

@@ -124,6 +124,7 @@ class BackendNode {
   std::vector<Published> published_;
   std::size_t max_message_bytes_ = 0;
   long messages_ = 0;
+  long poses_late_ = 0;  // frontend poses flagged FLAG_LATE, left out
   std::size_t edges_published_ = 0;
   BackendUpdate last_update_;  // optimisation counter and time of the newest update
   std::unique_ptr<ResendAnswerer> resend_;

@@ -74,6 +74,10 @@ DensifierNode::DensifierNode(Bus& bus, const DensifierConfig& config, CounterSin
 
 void DensifierNode::on_frontend(const pose2d_t& msg) {
   child_frame_ = msg.child_frame;
+  if (msg.flags & pose2d_t::FLAG_LATE) {  // not the base's pose at its stamp: no part of the path
+    ++dense_late_;
+    return;
+  }
   std::vector<Segment> closed;
   if (!densifier_.add_dense(msg.utime, Pose2(msg.x, msg.y, msg.theta), &closed)) {
     ++dense_rejected_;
@@ -130,6 +134,7 @@ void DensifierNode::report_counters() {
   counters_("segments_moved", static_cast<double>(densifier_.segments_moved()));
   counters_("spikes_replaced", static_cast<double>(densifier_.spikes_replaced()));
   counters_("dense_rejected", dense_rejected_);
+  counters_("dense_late", dense_late_);
   resend_->report(counters_);
 }
 

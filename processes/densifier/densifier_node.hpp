@@ -54,6 +54,7 @@ class DensifierNode {
   int32_t optimisation_ = 0;           // newest backend optimisation seen on KEY_POSES
   double segments_published_ = 0, segment_messages_ = 0, oversize_messages_ = 0;
   double dense_rejected_ = 0;
+  double dense_late_ = 0;  // frontend poses flagged FLAG_LATE, left out
   std::unique_ptr<ResendAnswerer> resend_;  // for DENSE_SEGMENTS
 };
 

@@ -70,6 +70,9 @@ struct FrontendResult {
   // The scan came far from the previous one (a log subsampled by travel, or a pause in a
   // scanner's stream): the wrappers of sparse/ act on such scans.
   bool sparse = false;
+  // The scan was taken before its stamp and stamped late: T_map_base is where its points belong,
+  // not the base's pose at utime (pose2d_t::FLAG_LATE).
+  bool late = false;
   std::optional<FrontendDiagnostics> diagnostics;
 };
 

@@ -167,9 +167,10 @@ void FrontendNode::publish(const FrontendResult& result) {
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) msg.covariance[3 * r + c] = covariance(r, c);
   }
-  msg.flags = result.status == ScanStatus::kPredicted ? pose2d_t::FLAG_PREDICTED : 0;
+  msg.flags = (result.status == ScanStatus::kPredicted ? pose2d_t::FLAG_PREDICTED : 0) |
+              (result.late ? pose2d_t::FLAG_LATE : 0);
   bus_.publish(config_.pose_channel, msg);
-  handover_.add_published(result.utime, T);
+  if (!result.late) handover_.add_published(result.utime, T);
   const auto period_us = static_cast<int64_t>(config_.handover.save_period_s * 1e6);
   if (!state_dir_.empty() && period_us > 0 &&
       (last_saved_utime_ == INT64_MIN || result.utime - last_saved_utime_ >= period_us)) {

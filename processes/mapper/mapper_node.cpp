@@ -141,6 +141,11 @@ void MapperNode::on_segments(const dense_segments_t& msg) {
 }
 
 void MapperNode::on_pose(const pose2d_t& msg) {
+  if (msg.flags & pose2d_t::FLAG_LATE) {  // not the base's pose at its stamp: no part of the path
+    ++poses_late_;
+    message_done();
+    return;
+  }
   open_.utimes.push_back(msg.utime);
   open_.T_world_base.emplace_back(msg.x, msg.y, msg.theta);
   if (static_cast<int>(open_.utimes.size()) > config_.poses_per_segment) cut_segment();
@@ -346,6 +351,7 @@ void MapperNode::report_counters() {
     lag_max = lag_max_s_;
   }
   counters_("profiles", s.profiles);
+  counters_("poses_late", poses_late_);
   counters_("annotated_key_poses", static_cast<double>(colours_.size()));
   counters_("annotation_level_changes", level_changes_);
   counters_("resend_requests_sent", resend_requests_sent_);

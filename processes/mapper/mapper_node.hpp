@@ -152,6 +152,7 @@ class MapperNode {
   PointColours colours_;             // the annotations, by key pose (this thread only)
   VoxelColourCounts voxel_colours_;  // of the last export (this thread only)
   double level_changes_ = 0, resend_requests_sent_ = 0;
+  double poses_late_ = 0;  // poses flagged FLAG_LATE on pose_channel, left out
   int64_t next_key_id_ = 0;
   std::unique_ptr<MapperStateStore> state_;  // written on this thread
   std::optional<Resumed> resumed_;

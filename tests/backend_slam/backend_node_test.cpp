@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 
 #include "drive_feed.hpp"
@@ -14,7 +15,8 @@ namespace {
 class BackendNodeTest : public ::testing::Test {
  protected:
   // Feeds a drive through the node over memq:// and collects its output.
-  void run(const BackendNodeConfig& config, double duration_s) {
+  // late_every > 0: every late_every-th pose is flagged FLAG_LATE (publish_drive_step).
+  void run(const BackendNodeConfig& config, double duration_s, std::size_t late_every = 0) {
     ASSERT_EQ(validate(config), std::nullopt);
     BackendNode node(bus_, config, [this](const std::string& k, double v) { counters_[k] = v; });
     bus_.subscribe<key_poses_t>(channels::kKeyPoses,
@@ -25,7 +27,9 @@ class BackendNodeTest : public ::testing::Test {
         channels::kPoseGraphEdges, [this](const pose_graph_edges_t& m) { edges_.push_back(m); });
     const test::Drive d = test::drive_ellipse(duration_s);
     for (std::size_t k = 0; k < d.utimes.size(); ++k) {
-      test::publish_drive_step(bus_, d, k);
+      const bool late = late_every > 0 && k % late_every == late_every - 1;
+      test::publish_drive_step(bus_, d, k, late);
+      if (late) late_utimes_.push_back(d.utimes[k]);
       handle_all();
     }
     node.finish();
@@ -45,8 +49,22 @@ class BackendNodeTest : public ::testing::Test {
   std::vector<pose2d_t> trajectory_;
   std::vector<pose_graph_edges_t> edges_;
   std::vector<int64_t> key_utimes_;
+  std::vector<int64_t> late_utimes_;
   int key_poses_ = 0;
 };
+
+// Poses flagged FLAG_LATE (a scan stamped late: where its points belong, not the base's pose at
+// its stamp) are counted and left out: no key pose at them, and the graph's poses stay on the
+// drive's.
+TEST_F(BackendNodeTest, LatePosesAreCountedAndLeftOut) {
+  run(BackendNodeConfig{}, 30.0, 7);
+  ASSERT_FALSE(late_utimes_.empty());
+  EXPECT_EQ(counters_.at("poses_late"), static_cast<double>(late_utimes_.size()));
+  for (const int64_t t : late_utimes_) {
+    EXPECT_EQ(std::count(key_utimes_.begin(), key_utimes_.end(), t), 0) << "key pose at " << t;
+  }
+  EXPECT_GT(key_poses_, 10);
+}
 
 TEST_F(BackendNodeTest, MessagesStayIncrementalAsTheGraphGrows) {
   BackendNodeConfig config;

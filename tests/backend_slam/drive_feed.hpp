@@ -14,7 +14,8 @@
 
 namespace traverse::backend::test {
 
-inline void publish_drive_step(Bus& bus, const Drive& d, std::size_t k) {
+// late: the pose is flagged pose2d_t::FLAG_LATE and lies 0.3 rad back (a scan stamped late).
+inline void publish_drive_step(Bus& bus, const Drive& d, std::size_t k, bool late = false) {
   const auto seq = static_cast<int64_t>(k);
   planar_scan_t scan = to_planar_scan_message(d.scans[k], "laser_horizontal", seq);
   bus.publish(channels::kScanHorizontal, scan);
@@ -25,7 +26,8 @@ inline void publish_drive_step(Bus& bus, const Drive& d, std::size_t k) {
   p.child_frame = "base";
   p.x = d.input[k].x();
   p.y = d.input[k].y();
-  p.theta = d.input[k].theta();
+  p.theta = d.input[k].theta() - (late ? 0.3 : 0.0);
+  p.flags = late ? pose2d_t::FLAG_LATE : 0;
   bus.publish(channels::kPoseFrontend, p);
 }
 

@@ -93,5 +93,60 @@ TEST(FrontendOdometry, OdometryThatStopsFallsBackAndIsCounted) {
   EXPECT_EQ(run.counters.at("scans_dropped_time"), 0);
 }
 
+// Turning almost in place in the room (0.6 rad/s) with odometry, one scan taken 0.5 s (0.3 rad)
+// before its stamp, as a logger that stamps on arrival leaves some (intel). Its pose is where it
+// was taken, it is counted, and the motion goes on from the odometry at its stamp: the poses
+// after it stay on the truth. Taken as the pose at its stamp, it turns the trajectory back 0.3
+// rad and the next scans' predictions with it.
+TEST(FrontendOdometry, AScanStampedLateKeepsItsPoseAndNotTheMotion) {
+  const auto truth = [](int64_t t) {
+    return Pose2(-1.0, 0.5, 0.2) *
+           Pose2::exp(Eigen::Vector3d(0.05, 0.0, 0.6) * (1e-6 * static_cast<double>(t)));
+  };
+  constexpr int64_t kLateUs = 500'000;
+  constexpr int kLateScan = 60;  // at 1.26 s
+  const auto world = synthetic::room();
+  const auto frontend = make_frontend(FrontendConfig{});
+  std::mt19937 rng(7);
+  int64_t odometry_t = 0;
+  Pose2 T_map_world;
+  double max_position_error_m = 0.0, max_heading_error_rad = 0.0, late_heading_error_rad = 1.0;
+  for (int k = 0; k < 120; ++k) {
+    const int64_t t0 = k * kPeriodUs;
+    const bool late = k == kLateScan;
+    Scan scan = synthetic::make_sweep(world, truth, Pose2(), small_sweep(late ? t0 - kLateUs : t0),
+                                      &rng);
+    if (late) {
+      scan.utime_first += kLateUs;
+      scan.utime_last += kLateUs;
+    }
+    for (; odometry_t <= scan.utime_last; odometry_t += 20'000) {
+      OdometrySample o;
+      o.utime = odometry_t;
+      o.T_odom_base = Pose2(3.0, 1.0, 0.5) * truth(odometry_t);
+      ASSERT_TRUE(frontend->add_odometry(o));
+    }
+    const FrontendResult r = frontend->process(scan);
+    if (k == 0) T_map_world = r.T_map_base * truth(scan.utime_last).inverse();
+    const Pose2 T_true = T_map_world * truth(scan.utime_last - (late ? kLateUs : 0));
+    const double heading_error = std::abs(wrap_angle(r.T_map_base.theta() - T_true.theta()));
+    if (late) {
+      late_heading_error_rad = heading_error;
+      continue;
+    }
+    max_position_error_m = std::max(max_position_error_m,
+                                    (r.T_map_base.translation() - T_true.translation()).norm());
+    max_heading_error_rad = std::max(max_heading_error_rad, heading_error);
+  }
+  const auto counters = testing::counters_of(*frontend);
+  std::printf("late scan: its heading %.4f rad from where it was taken; the others at most %.4f m "
+              "%.4f rad off\n",
+              late_heading_error_rad, max_position_error_m, max_heading_error_rad);
+  EXPECT_EQ(counters.at("scans_late"), 1);
+  EXPECT_LT(late_heading_error_rad, 0.01);
+  EXPECT_LT(max_position_error_m, 0.02);
+  EXPECT_LT(max_heading_error_rad, 0.01);
+}
+
 }  // namespace
 }  // namespace traverse::frontend

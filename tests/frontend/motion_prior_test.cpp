@@ -67,6 +67,27 @@ TEST(MotionPrior, ExtrapolatesALittleThenFallsBackAsStale) {
   EXPECT_EQ(miss, OdometryMiss::kStale);
 }
 
+// A logger that stamps samples on arrival bunches them (intel: several a millisecond apart, then
+// nothing for half a second). Carried past the newest sample, the rate is measured over at least
+// the time it is carried: the last increment alone (1 ms) carried 90 ms on would be 90 of them.
+TEST(MotionPrior, ExtrapolatesAtTheRateOverAsLongAsItCarriesIt) {
+  MotionPrior prior(MotionPriorConfig{});
+  feed(prior, 0, 200'000);  // on time, every 20 ms, to 0.2 s
+  // The samples of 0.22, 0.24 and 0.26 s arrive, and are stamped, at 0.500, 0.501 and 0.502 s.
+  for (int i = 0; i < 3; ++i) {
+    OdometrySample o = sample_at(220'000 + 20'000 * i);
+    o.utime = 500'000 + 1'000 * i;
+    ASSERT_TRUE(prior.add_odometry(o));
+  }
+  const auto step = prior.odometry_step(200'000, 592'000);
+  ASSERT_TRUE(step);
+  EXPECT_TRUE(step->extrapolated);
+  // From 0.2 s the base went 0.06 m by the samples, then at their rate over the 0.302 s since
+  // 0.2 s (0.2 m/s) for the 0.09 s past the newest: 0.078 m. One millisecond's increment (0.02 m)
+  // carried 90 ms on would make it 1.86 m.
+  EXPECT_NEAR(step->T_base0_base1.translation().norm(), 0.06 + 0.06 * 90.0 / 302.0, 0.005);
+}
+
 TEST(MotionPrior, MissingGappedAndOutOfOrderOdometry) {
   MotionPriorConfig config;
   config.odometry_max_gap_us = 500'000;

@@ -133,6 +133,18 @@ Measurement HectorFrontend::measure(const Scan& scan) {
     d.T_map_base_predicted = T_pred;
     const MatchResult& match = attempt.match;
     if (match.searched) ++counters_.scans_searched;
+    // A match far behind both the prediction and the last pose, on the path before it, is a
+    // scan taken back there and stamped late (a logger that stamps on arrival: intel holds about a
+    // hundred): its pose is where it fits, and the motion goes on from the prediction at its
+    // stamp (integrate()). Taking it as the pose at its stamp turns the trajectory back and the
+    // next prediction with it (intel from a start 1 mrad off: the frontend lost, relations 6.85 m).
+    if (!attempt.unverified && attempt.prediction.odometry && !r.sparse &&
+        motion_.taken_earlier(match.T_map_base, T_pred, config_.motion_prior.search_min_linear_m,
+                              config_.motion_prior.search_min_angular_rad)) {
+      ++counters_.scans_late;
+      m.late = true;
+      r.late = true;
+    }
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
     // from that with a poor fit (after the recovery search, see search_max_unverified_m) comes
     // from a scan that fits nowhere (people round the scanner, a view the map has not seen).
@@ -320,6 +332,11 @@ void HectorFrontend::integrate(Measurement& m) {
     return;
   }
   if (r.status != ScanStatus::kMatched) return;
+  if (m.late) {
+    motion_.add_prediction(r.utime, r.diagnostics->T_map_base_predicted, r.covariance, r.sparse,
+                           true);
+    return;
+  }
   motion_.add_pose(r.utime, r.T_map_base, r.covariance, r.sparse);
   r.diagnostics->map_updated = false;
   if (T_map_base_last_update_ && !map_update_due(r.T_map_base)) return;
@@ -378,6 +395,7 @@ void HectorFrontend::report(const CounterSink& sink) const {
   sink("scans_matched", static_cast<double>(c.scans_matched));
   sink("scans_predicted", static_cast<double>(c.scans_predicted));
   sink("scans_unverified", static_cast<double>(c.scans_unverified));
+  sink("scans_late", static_cast<double>(c.scans_late));
   sink("scans_searched", static_cast<double>(c.scans_searched));
   sink("scans_degenerate", static_cast<double>(c.scans_degenerate));
   sink("scans_dropped_time", static_cast<double>(c.scans_dropped_time));

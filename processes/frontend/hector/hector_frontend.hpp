@@ -14,7 +14,10 @@
 //      best pose of a wide correlative search around it (grid_search.hpp), which on a log
 //      subsampled by travel also weighs the step's shape (step_prior.hpp);
 //   5. a match on a scanner's stream that lands far from the prediction with a poor fit is not
-//      trusted: the pose is the prediction, flagged, and the scan stays out of the map;
+//      trusted: the pose is the prediction, flagged, and the scan stays out of the map; one that
+//      lands, with odometry, far behind the prediction and the last pose on the path before it
+//      was taken back there and stamped late: its pose is the match, the scan stays out of the
+//      map and the motion goes on from the prediction;
 //   6. directions of the pose the scan does not determine (a bare corridor's axis) keep the
 //      prediction, and its covariance (degeneracy.hpp).
 // Integrating it: the pose goes into the motion model, and the scan into the map when the pose
@@ -62,6 +65,7 @@ class HectorFrontend final : public TwoPhaseFrontend {
     int64_t scans_matched = 0;
     int64_t scans_predicted = 0;     // too few valid points
     int64_t scans_unverified = 0;    // match far from the prediction with a poor fit: predicted
+    int64_t scans_late = 0;          // match on the path before the last pose: predicted
     int64_t scans_searched = 0;      // matches that needed a correlative search
     int64_t scans_degenerate = 0;    // matches with a direction held at the prediction
     int64_t scans_dropped_time = 0;  // time going backwards or utime_last < utime_first

@@ -11,6 +11,9 @@ constexpr int64_t kImuStaleUs = 500'000;
 // Velocity estimates closer than this in time are averaged (exponentially) to tame the noise of
 // differencing poses a few milliseconds apart.
 constexpr double kVelocitySmoothingS = 0.1;
+// The poses of the last kRecentPathUs (at most kRecentPathPoses) are held for taken_earlier().
+constexpr int64_t kRecentPathUs = 1'000'000;
+constexpr std::size_t kRecentPathPoses = 100;
 // Weight of the newest step in the average step of sparse scans.
 constexpr double kSparseStepSmoothing = 0.3;
 }  // namespace
@@ -44,17 +47,45 @@ void MotionModel::add_pose(int64_t utime, const Pose2& T_map_base,
     }
     s.recent_intervals_us.add(static_cast<double>(interval_us));
   }
+  s.recent_path.emplace_back(utime, T_map_base);
+  while (s.recent_path.size() > kRecentPathPoses ||
+         s.recent_path.front().first < utime - kRecentPathUs)
+    s.recent_path.pop_front();
   s.T_map_base_last = T_map_base;
   s.last_utime = utime;
+  s.last_late = false;
   s.covariance_last = covariance;
   s.initialised = true;
 }
 
 void MotionModel::add_prediction(int64_t utime, const Pose2& T_map_base,
-                                 const Eigen::Matrix3d& covariance, bool sparse) {
+                                 const Eigen::Matrix3d& covariance, bool sparse, bool late) {
   const Eigen::Vector3d velocity = state_.velocity;
   add_pose(utime, T_map_base, covariance, sparse);
   state_.velocity = velocity;  // a prediction carries no new information about the motion
+  state_.last_late = late;
+}
+
+bool MotionModel::taken_earlier(const Pose2& T_match, const Pose2& T_predicted, double scale_xy,
+                                double scale_theta) const {
+  const auto distance = [&](const Pose2& a, const Pose2& b) {
+    const Eigen::Vector3d d = between(a, b).log();
+    return std::max(d.head<2>().norm() / scale_xy, std::abs(d.z()) / scale_theta);
+  };
+  const auto& path = state_.recent_path;
+  if (state_.last_late || path.size() < 3 || distance(path.back().second, T_match) <= 2.0 / 3.0 ||
+      distance(T_predicted, T_match) <= 2.0 / 3.0)
+    return false;
+  constexpr int kSteps = 10;  // points looked at per segment
+  for (std::size_t i = 1; i + 1 < path.size(); ++i) {
+    const Pose2& from = path[i - 1].second;
+    const Eigen::Vector3d step = between(from, path[i].second).log();
+    for (int k = 0; k <= kSteps; ++k) {
+      if (distance(from * Pose2::exp(step * (static_cast<double>(k) / kSteps)), T_match) < 1.0 / 3.0)
+        return true;
+    }
+  }
+  return false;
 }
 
 bool MotionModel::imu_covers(int64_t from, int64_t to) const {

@@ -24,7 +24,9 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <optional>
+#include <utility>
 
 #include "frontend.hpp"
 #include "motion_prior.hpp"
@@ -49,8 +51,9 @@ class MotionModel {
   void add_pose(int64_t utime, const Pose2& T_map_base, const Eigen::Matrix3d& covariance,
                 bool sparse);
   // A predicted pose (nothing was measured): as add_pose, but the velocity stays as it was.
+  // late: the prediction at the stamp of a scan taken earlier (taken_earlier()).
   void add_prediction(int64_t utime, const Pose2& T_map_base, const Eigen::Matrix3d& covariance,
-                      bool sparse);
+                      bool sparse, bool late = false);
 
   bool initialised() const { return state_.initialised; }  // a pose was added
   const Pose2& last_pose() const { return state_.T_map_base_last; }
@@ -69,6 +72,14 @@ class MotionModel {
   bool subsampled_by_travel(int64_t gap_us) const;
   // Five intervals between poses seen: subsampled_by_travel() can tell.
   bool pace_known() const { return state_.recent_intervals_us.size() == 5; }
+  // A match at T_match from the prediction T_predicted lies on the path of the poses before the
+  // last (within a third of a unit of one of its segments) and away from both the last pose and
+  // the prediction (more than two thirds of a unit), where a unit is scale_xy in x and y and
+  // scale_theta in heading: a scan taken back there and stamped late (intel's log holds such
+  // scans, arriving up to a second after the next ones). Never two in a row: a second is the
+  // prediction that is off (odometry that slipped), not the scan.
+  bool taken_earlier(const Pose2& T_match, const Pose2& T_predicted, double scale_xy,
+                     double scale_theta) const;
 
   // The pose at `utime` (after the last pose), see the header. use_imu: imu_covers() from the
   // last pose to utime; sparse: the scan is a sparse one.
@@ -98,6 +109,9 @@ class MotionModel {
     // Average step per sparse scan (log of the relative pose, base frame).
     std::optional<Eigen::Vector3d> sparse_step;
     RecentValues<5> recent_intervals_us;  // between the last poses [us]
+    // The poses of the last second, oldest first, with their times [us]: taken_earlier().
+    std::deque<std::pair<int64_t, Pose2>> recent_path;
+    bool last_late = false;  // the last pose is the prediction at a late scan's stamp
   };
   const State& state() const { return state_; }
   void restore(const State& state) { state_ = state; }
