@@ -29,9 +29,6 @@ struct Measurement {
   // A step the data show is long: its length [m], where a search wider than the wide search's
   // window found the scan (sparse/widen.hpp). The lag does not count a step up to it as long.
   std::optional<double> long_step_m;
-  // The scan was taken before the pose before it and stamped late: its pose is where it fits,
-  // and the motion goes on from the prediction at its stamp.
-  bool late = false;
 };
 
 // A result the wide search matched as a sparse scan: what the wrappers of sparse/ work on.

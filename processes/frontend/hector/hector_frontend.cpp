@@ -142,7 +142,6 @@ Measurement HectorFrontend::measure(const Scan& scan) {
         motion_.taken_earlier(match.T_map_base, T_pred, config_.motion_prior.search_min_linear_m,
                               config_.motion_prior.search_min_angular_rad)) {
       ++counters_.scans_late;
-      m.late = true;
       r.late = true;
     }
     // A scanner's stream predicts the pose a period ahead to centimetres. A match that ends far
@@ -332,7 +331,7 @@ void HectorFrontend::integrate(Measurement& m) {
     return;
   }
   if (r.status != ScanStatus::kMatched) return;
-  if (m.late) {
+  if (r.late) {
     motion_.add_prediction(r.utime, r.diagnostics->T_map_base_predicted, r.covariance, r.sparse,
                            true);
     return;

@@ -65,7 +65,7 @@ class HectorFrontend final : public TwoPhaseFrontend {
     int64_t scans_matched = 0;
     int64_t scans_predicted = 0;     // too few valid points
     int64_t scans_unverified = 0;    // match far from the prediction with a poor fit: predicted
-    int64_t scans_late = 0;          // match on the path before the last pose: predicted
+    int64_t scans_late = 0;          // match on the path before the last pose: stamped late
     int64_t scans_searched = 0;      // matches that needed a correlative search
     int64_t scans_degenerate = 0;    // matches with a direction held at the prediction
     int64_t scans_dropped_time = 0;  // time going backwards or utime_last < utime_first
