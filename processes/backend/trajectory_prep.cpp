@@ -15,6 +15,7 @@ constexpr std::size_t kRecentIntervals = 5;  // as the frontend's rule
 // 0.13-0.30 s, fr079 0.21-0.22 s; subsampled by travel, intel 2.1-3.8 s, aces 2.1-4.1 s.
 constexpr std::size_t kPaceIntervals = 51;
 constexpr int64_t kPacedMeanUs = 500000;
+constexpr int64_t kMaxPaceIntervalUs = 1000000000000;
 
 }  // namespace
 
@@ -49,7 +50,8 @@ std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {
   if (last_utime != INT64_MIN) {
     intervals_us_.push_back(pose.utime - last_utime);
     if (intervals_us_.size() > kRecentIntervals) intervals_us_.pop_front();
-    pace_us_.push_back(pose.utime - last_utime);
+    // Held to 10^6 s: the sum of 51 stays far within int64 whatever the stamps.
+    pace_us_.push_back(std::min<int64_t>(pose.utime - last_utime, kMaxPaceIntervalUs));
     pace_sum_us_ += pace_us_.back();
     if (pace_us_.size() > kPaceIntervals) {
       pace_sum_us_ -= pace_us_.front();
