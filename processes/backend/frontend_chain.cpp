@@ -10,6 +10,9 @@ namespace {
 // Below this travel a step still drifts as much as this [m]: a standstill keeps a finite
 // information.
 constexpr double kMinDriftTravelM = 0.01;
+// In a scanner's stream one pose's covariance enters the drift at most this many times its
+// neighbour's (by their position variances) [unitless].
+constexpr double kMaxDriftRatio = 10.0;
 
 }  // namespace
 
@@ -30,7 +33,14 @@ Edge drift_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
   edge.T_from_to = between(a.T_world_base, b.T_world_base);
   const double travel = std::max(
       kMinDriftTravelM, b.travel_m - a.travel_m + kTurnLeverM * std::abs(edge.T_from_to.theta()));
-  edge.information = (travel / drift_length_m * 0.5 * (ca + cb)).inverse();
+  Eigen::Matrix3d la = ca, lb = cb;
+  if (a.paced && b.paced) {
+    const double pa = ca(0, 0) + ca(1, 1), pb = cb(0, 0) + cb(1, 1);
+    if (pa > kMaxDriftRatio * pb) la *= kMaxDriftRatio * pb / pa;
+    if (pb > kMaxDriftRatio * pa) lb *= kMaxDriftRatio * pa / pb;
+  }
+  const Eigen::Matrix3d typical = 0.5 * (la + lb);
+  edge.information = (travel / drift_length_m * typical).inverse();
   return edge;
 }
 

@@ -36,7 +36,13 @@ Eigen::Matrix3d frontend_pose_covariance(const PreparedPose& pose, double scale,
                                          const Eigen::Matrix3d& fallback);
 
 // The edge M_a -> M_b of the drift model: the frontend's motion from a to b with the map's drift
-// over it; ca, cb: the two poses' covariances (frontend_pose_covariance).
+// over it; ca, cb: the two poses' covariances (frontend_pose_covariance). The map drifts by the
+// frontend's typical error, the mean of the two covariances. In a scanner's stream (both poses
+// paced, PreparedPose::paced) one scan among hundreds hardly moves the map, so one ambiguous
+// match (a sparse scan after a pause whose search found a second place it fits) moves its own
+// pose and not the drift: a covariance more than ten times its neighbour's (by the position
+// variances) enters the mean scaled down to ten times. In a log subsampled by travel each scan is
+// much of the map where it lies, and an ambiguous one moves it: the mean as it is.
 Edge drift_edge(int from, int to, const PreparedPose& a, const PreparedPose& b,
                 const Eigen::Matrix3d& ca, const Eigen::Matrix3d& cb, double drift_length_m);
 

@@ -9,6 +9,13 @@ namespace traverse::backend {
 namespace {
 
 constexpr std::size_t kRecentIntervals = 5;  // as the frontend's rule
+// Paced as a scanner's stream at large (PreparedPose::paced): the mean of this many intervals
+// within [min_stream_interval_us, kPacedMeanUs]. The mean over 51 intervals, from the least to
+// the most: full-rate intel 0.15-0.25 s (bursts 1 ms apart after stalls of up to 2 s), aces
+// 0.13-0.30 s, fr079 0.21-0.22 s; subsampled by travel, intel 2.1-3.8 s, aces 2.1-4.1 s.
+constexpr std::size_t kPaceIntervals = 51;
+constexpr int64_t kPacedMeanUs = 500000;
+constexpr int64_t kMaxPaceIntervalUs = 1000000000000;
 
 }  // namespace
 
@@ -26,6 +33,13 @@ bool TrajectoryPrep::sparse() const {
   return *hi > config_.sparse_interval_us || *lo < config_.min_stream_interval_us;
 }
 
+bool TrajectoryPrep::paced() const {
+  if (config_.input == "stream") return true;
+  if (config_.input == "sparse" || pace_us_.size() < kRecentIntervals) return false;
+  const auto n = static_cast<int64_t>(pace_us_.size());
+  return pace_sum_us_ >= config_.min_stream_interval_us * n && pace_sum_us_ <= kPacedMeanUs * n;
+}
+
 std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {
   ++counters_.poses;
   const int64_t last_utime = held_ ? held_->utime : (last_ ? last_->utime : INT64_MIN);
@@ -36,6 +50,13 @@ std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {
   if (last_utime != INT64_MIN) {
     intervals_us_.push_back(pose.utime - last_utime);
     if (intervals_us_.size() > kRecentIntervals) intervals_us_.pop_front();
+    // Held to 10^6 s: the sum of 51 stays far within int64 whatever the stamps.
+    pace_us_.push_back(std::min<int64_t>(pose.utime - last_utime, kMaxPaceIntervalUs));
+    pace_sum_us_ += pace_us_.back();
+    if (pace_us_.size() > kPaceIntervals) {
+      pace_sum_us_ -= pace_us_.front();
+      pace_us_.pop_front();
+    }
   }
   if (!held_) {
     held_ = pose;
@@ -50,6 +71,8 @@ void TrajectoryPrep::resume(const PreparedPose& last, const TrajectoryPrepCounte
   counters_ = counters;
   held_.reset();
   intervals_us_.clear();
+  pace_us_.clear();
+  pace_sum_us_ = 0;
   last_ = last;
   smoother_.restart({last.utime, last.frontend.T_map_base}, last.T_world_base);
 }
@@ -65,6 +88,7 @@ PreparedPose TrajectoryPrep::prepare(FrontendPose pose, const std::optional<Fron
   PreparedPose out;
   out.utime = pose.utime;
   out.sparse = sparse();
+  out.paced = paced();
   const StampedPose raw{pose.utime, pose.T_map_base};
   if (!last_) {
     out.T_world_base = pose.T_map_base;

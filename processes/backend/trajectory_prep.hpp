@@ -43,6 +43,10 @@ struct PreparedPose {
   FrontendPose frontend;  // the frontend's pose (an outlier replaced by its neighbours')
   double travel_m = 0.0;  // [m] distance along the prepared trajectory from its first pose
   bool sparse = false;    // taken as a log subsampled by travel
+  // Paced as a scanner's stream at large: the mean of the last 51 intervals between
+  // min_stream_interval_us and 0.5 s, a pause or a burst in it aside; a log subsampled by travel
+  // (seconds apart) or whose stamps are squeezed together is not.
+  bool paced = false;
 };
 
 struct TrajectoryPrepCounters {
@@ -72,6 +76,8 @@ class TrajectoryPrep {
  private:
   // Whether the poses are taken as a log subsampled by travel (after the newest interval).
   bool sparse() const;
+  // Whether they are paced as a scanner's stream at large (PreparedPose::paced).
+  bool paced() const;
   PreparedPose prepare(FrontendPose pose, const std::optional<FrontendPose>& next);
 
   JumpSmoothingConfig config_;
@@ -80,6 +86,8 @@ class TrajectoryPrep {
   std::optional<FrontendPose> held_;  // the newest pose, not yet prepared
   std::optional<PreparedPose> last_;  // the last prepared pose
   std::deque<int64_t> intervals_us_;  // the last intervals between poses given [us]
+  std::deque<int64_t> pace_us_;       // ... more of them, for paced() [us]
+  int64_t pace_sum_us_ = 0;           // their sum [us]
 };
 
 struct KeyPoseConfig {

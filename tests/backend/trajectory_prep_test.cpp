@@ -175,5 +175,34 @@ TEST(TrajectoryPrep, StampsSqueezedTogetherAreNotAStream) {
   }
 }
 
+// A scanner's stream stays paced through a pause in it (intel's logger stalls up to 2 s); a log
+// subsampled by travel (a scan seconds apart) and stamps squeezed together (all-zero stamps
+// restamped 1 us apart) are not (frontend_chain.hpp: how the drift model weighs one ambiguous
+// match).
+TEST(TrajectoryPrep, AStreamStaysPacedThroughAPause) {
+  const auto paced_share = [](const std::vector<int64_t>& intervals_us) {
+    JumpSmoothingConfig config;
+    config.sparse_interval_us = 100000;  // configs/backend.yaml
+    TrajectoryPrep prep(config);
+    int64_t t = 0;
+    int paced = 0, n = 0;
+    for (std::size_t k = 0; k < 200; ++k) {
+      t += intervals_us[k % intervals_us.size()];
+      const auto q = prep.add({t, Pose2(0.1 * static_cast<double>(k), 0.0, 0.0)});
+      if (q && k > 60) {
+        ++n;
+        if (q->paced) ++paced;
+      }
+    }
+    return static_cast<double>(paced) / n;
+  };
+  std::vector<int64_t> stream(40, 100000);  // 10 Hz ...
+  stream.push_back(2000000);                // ... with a 2 s pause every 4 s
+  EXPECT_EQ(paced_share(stream), 1.0);
+  EXPECT_EQ(paced_share({80000, 1000, 1000, 300000}), 1.0);  // bursts after gaps (intel)
+  EXPECT_EQ(paced_share({2000000, 3400000}), 0.0);           // subsampled by travel
+  EXPECT_EQ(paced_share({1}), 0.0);                          // all-zero stamps, restamped
+}
+
 }  // namespace
 }  // namespace traverse::backend
