@@ -291,6 +291,7 @@ void BackendNode::report_counters() {
   counters_("loop_rejected_response", static_cast<double>(l.rejected_response));
   counters_("loop_rejected_ambiguous", static_cast<double>(l.rejected_ambiguous));
   counters_("loop_rejected_covariance", static_cast<double>(l.rejected_covariance));
+  counters_("loop_opened", static_cast<double>(l.opened));
   counters_("loop_refined", static_cast<double>(l.refined));
   counters_("loop_refine_failed", static_cast<double>(l.refine_failed));
   counters_("loop_rejected_inconsistent", static_cast<double>(l.rejected_inconsistent));

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "config.hpp"
+#include "degeneracy.hpp"
 
 namespace traverse::backend {
 
@@ -24,6 +25,8 @@ std::optional<std::string> validate(const LoopCloserConfig& c) {
   check.positive("max_sigma_theta_rad", c.max_sigma_theta_rad);
   check.not_negative("max_correction_mahalanobis", c.max_correction_mahalanobis);
   check.positive("covariance_scale", c.covariance_scale);
+  check.in_range("degeneracy_min_ratio", c.degeneracy_min_ratio, 0.0, 1.0);
+  check.positive("open_sigma_m", c.open_sigma_m);
   check.nested("coarse", validate(c.coarse));
   check.nested("fine", validate(c.fine));
   check.nested("refine", validate(c.refine));
@@ -77,6 +80,14 @@ std::optional<LoopClosure> LoopCloser::try_candidate(
       ++counters_.refined;
       T_world_current = refined.T_world_query;
       if (config_.refined_covariance) covariance = refined.covariance;
+      if (config_.degeneracy_min_ratio > 0.0) {
+        const Degeneracy d = analyse_degeneracy(refined.information, refined.lever_m,
+                                                config_.degeneracy_min_ratio);
+        if (d.directions > 0) {
+          ++counters_.opened;
+          covariance = opened_covariance(d, covariance, config_.open_sigma_m);
+        }
+      }
     } else {
       ++counters_.refine_failed;
     }

@@ -80,6 +80,14 @@ struct LoopCloserConfig {
   // weighting closures by it made the trajectory worse (2.5 mm against 0.96 mm position RMSE).
   RefinerConfig refine;
   bool refined_covariance = false;  // the closure takes the refinement's covariance instead
+  // A closure whose refinement leaves a direction open (a corridor's axis: an eigenvalue of the
+  // refiner's information below this share of the largest, common/degeneracy.hpp) is opened
+  // there, before the correction check, by the variance its information allows, at most
+  // open_sigma_m: the correlative surface claims centimetres along such an axis where the scans
+  // can slip by decimetres (intel, sub-cell hits, full graph: a closure 0.37 m off along a
+  // corridor with a 3.6 cm sigma bent a minute of the log by 0.27 m). 0: never opened.
+  double degeneracy_min_ratio = 0.0;
+  double open_sigma_m = 10.0;  // [m] of point motion
 
   template <class V>
   void visit(V& v) {
@@ -100,6 +108,8 @@ struct LoopCloserConfig {
     v("fine", fine);
     v("refine", refine);
     v("refined_covariance", refined_covariance);
+    v("degeneracy_min_ratio", degeneracy_min_ratio);
+    v("open_sigma_m", open_sigma_m);
   }
 };
 
@@ -127,6 +137,7 @@ struct LoopCloserCounters {
   long rejected_covariance = 0;
   long refined = 0;                // fine matches refined point to line
   long refine_failed = 0;          // ... where refinement failed (the fine match is kept)
+  long opened = 0;                 // ... left a direction open: the covariance opened there
   long rejected_inconsistent = 0;  // correction too large for the marginals
   long closures = 0;
 };

@@ -22,7 +22,7 @@ struct ClosureRun {
 };
 
 ClosureRun run(const World& world, const std::vector<double>& current_x, const Pose2& drift,
-               int chain_first_step = 0) {
+               int chain_first_step = 0, LoopCloserConfig config = {}) {
   std::mt19937 rng(3);
   ScanStore scans;
   ClosureRun r;
@@ -43,7 +43,6 @@ ClosureRun run(const World& world, const std::vector<double>& current_x, const P
   }
   for (const Pose2& T : r.truth) scans.add(test::key_points(world, T, kRange, rng));
 
-  LoopCloserConfig config;
   config.coarse.max_query_points = 300;
   LoopCloser closer(config);
   for (int i = r.first_current; i < static_cast<int>(poses.size()); ++i) {
@@ -88,6 +87,35 @@ TEST(LoopCloser, NoEpisodeWithoutOldKeyPosesNearby) {
   const ClosureRun r = run(test::irregular_corridor(), {12.0, 11.5}, Pose2());
   EXPECT_TRUE(r.closures.empty());
   EXPECT_EQ(r.counters.candidates, 0);
+}
+
+// A corridor bare but for one shallow niche: the refinement's information along the axis is a
+// small share of the rest. Opened (degeneracy_min_ratio), the closure's covariance along the axis
+// is what its information allows, not the correlative surface's centimetres; across it nothing
+// changes. (The ambiguity check is off here, to reach the covariance: on intel such closures
+// pass it.)
+TEST(LoopCloser, AClosureAlongAnAlmostBareCorridorIsOpenedAlongItsAxis) {
+  World world = test::synthetic::corridor(60.0, 2.4);
+  world.push_back({{3.0, 1.2}, {3.0, 1.25}});  // a niche 5 cm deep in the north wall
+  world.push_back({{3.0, 1.25}, {3.4, 1.25}});
+  world.push_back({{3.4, 1.25}, {3.4, 1.2}});
+  const Pose2 drift(0.2, 0.0, 0.0);
+  std::vector<ClosureRun> runs;
+  for (const double ratio : {0.0, 0.01}) {
+    LoopCloserConfig config;
+    config.degeneracy_min_ratio = ratio;
+    config.max_ambiguity_ratio = 1.0;
+    runs.push_back(run(world, {5.6, 5.2, 4.8, 4.4}, drift, 0, config));
+  }
+  ASSERT_EQ(runs[0].closures.size(), 1u);
+  ASSERT_EQ(runs[1].closures.size(), 1u);
+  EXPECT_EQ(runs[0].counters.opened, 0);
+  EXPECT_EQ(runs[1].counters.opened, 1);
+  const Eigen::Matrix3d& plain = runs[0].closures[0].covariance;
+  const Eigen::Matrix3d& opened = runs[1].closures[0].covariance;
+  // The corridor's axis is x in the world and, coming back, in the closure's frame too.
+  EXPECT_GT(std::sqrt(opened(0, 0)), 1.5 * std::sqrt(plain(0, 0)));
+  EXPECT_NEAR(std::sqrt(opened(1, 1)), std::sqrt(plain(1, 1)), 0.01 * std::sqrt(plain(1, 1)));
 }
 
 }  // namespace
