@@ -26,17 +26,18 @@ bool TrajectoryPrep::sparse() const {
   if (config_.input == "stream") return false;
   if (config_.input == "sparse") return true;
   if (intervals_us_.size() < kRecentIntervals) return false;
+  const auto recent = intervals_us_.end() - static_cast<std::ptrdiff_t>(kRecentIntervals);
   // A scanner's stream: every recent interval within [min_stream_interval_us,
   // sparse_interval_us]. One longer (a log subsampled by travel) or shorter (stamps squeezed
   // together where a log's clock failed) says the times do not pace the motion.
-  const auto [lo, hi] = std::minmax_element(intervals_us_.begin(), intervals_us_.end());
+  const auto [lo, hi] = std::minmax_element(recent, intervals_us_.end());
   return *hi > config_.sparse_interval_us || *lo < config_.min_stream_interval_us;
 }
 
 bool TrajectoryPrep::paced() const {
   if (config_.input == "stream") return true;
-  if (config_.input == "sparse" || pace_us_.size() < kRecentIntervals) return false;
-  const auto n = static_cast<int64_t>(pace_us_.size());
+  if (config_.input == "sparse" || intervals_us_.size() < kRecentIntervals) return false;
+  const auto n = static_cast<int64_t>(intervals_us_.size());
   return pace_sum_us_ >= config_.min_stream_interval_us * n && pace_sum_us_ <= kPacedMeanUs * n;
 }
 
@@ -48,14 +49,13 @@ std::optional<PreparedPose> TrajectoryPrep::add(const FrontendPose& pose) {
     return std::nullopt;
   }
   if (last_utime != INT64_MIN) {
+    // Each held to 10^6 s in the sum: the sum of 51 stays far within int64 whatever the stamps.
+    const auto held = [](int64_t us) { return std::min(us, kMaxPaceIntervalUs); };
     intervals_us_.push_back(pose.utime - last_utime);
-    if (intervals_us_.size() > kRecentIntervals) intervals_us_.pop_front();
-    // Held to 10^6 s: the sum of 51 stays far within int64 whatever the stamps.
-    pace_us_.push_back(std::min<int64_t>(pose.utime - last_utime, kMaxPaceIntervalUs));
-    pace_sum_us_ += pace_us_.back();
-    if (pace_us_.size() > kPaceIntervals) {
-      pace_sum_us_ -= pace_us_.front();
-      pace_us_.pop_front();
+    pace_sum_us_ += held(intervals_us_.back());
+    if (intervals_us_.size() > kPaceIntervals) {
+      pace_sum_us_ -= held(intervals_us_.front());
+      intervals_us_.pop_front();
     }
   }
   if (!held_) {
@@ -71,7 +71,6 @@ void TrajectoryPrep::resume(const PreparedPose& last, const TrajectoryPrepCounte
   counters_ = counters;
   held_.reset();
   intervals_us_.clear();
-  pace_us_.clear();
   pace_sum_us_ = 0;
   last_ = last;
   smoother_.restart({last.utime, last.frontend.T_map_base}, last.T_world_base);

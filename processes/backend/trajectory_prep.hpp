@@ -85,9 +85,9 @@ class TrajectoryPrep {
   TrajectoryPrepCounters counters_;
   std::optional<FrontendPose> held_;  // the newest pose, not yet prepared
   std::optional<PreparedPose> last_;  // the last prepared pose
-  std::deque<int64_t> intervals_us_;  // the last intervals between poses given [us]
-  std::deque<int64_t> pace_us_;       // ... more of them, for paced() [us]
-  int64_t pace_sum_us_ = 0;           // their sum [us]
+  // The last intervals between poses given [us]: sparse() reads the newest five, paced() all 51.
+  std::deque<int64_t> intervals_us_;
+  int64_t pace_sum_us_ = 0;  // their sum, each held to 10^6 s [us]
 };
 
 struct KeyPoseConfig {
