@@ -30,6 +30,9 @@ struct StampedPose {
 };
 
 struct JumpSmoothingConfig {
+  // false: the frontend's steps go in as they are (no step or pose replaced); `input` still tells
+  // a scanner's stream from a log subsampled by travel for the rest of the backend.
+  bool enabled = true;
   int window = 10;                        // preceding steps averaged [steps]
   double speed_ratio = 3.0;               // a step faster than ratio * average speed is a jump
   double min_jump_speed_mps = 0.5;        // ... and faster than this [m/s] (ignores jitter at rest)
@@ -52,6 +55,7 @@ struct JumpSmoothingConfig {
 
   template <class V>
   void visit(V& v) {
+    v("enabled", enabled);
     v("window", window);
     v("speed_ratio", speed_ratio);
     v("min_jump_speed_mps", min_jump_speed_mps);

@@ -92,9 +92,9 @@ PreparedPose TrajectoryPrep::prepare(FrontendPose pose, const std::optional<Fron
   if (!last_) {
     out.T_world_base = pose.T_map_base;
     smoother_.restart(raw, out.T_world_base);
-  } else if (out.sparse) {
-    // Subsampled by travel: the frontend's step as it is.
-    ++counters_.sparse_poses;
+  } else if (out.sparse || !config_.enabled) {
+    // Subsampled by travel, or no smoothing: the frontend's step as it is.
+    if (out.sparse) ++counters_.sparse_poses;
     out.T_world_base = last_->T_world_base * between(last_->frontend.T_map_base, pose.T_map_base);
     smoother_.restart(raw, out.T_world_base);
   } else {

@@ -312,6 +312,10 @@ void MapperNode::publish_preview() {
   resend_store_->poll();  // a pass that has finished
   for (const std::vector<PreviewProfile>& group : preview_->take()) {
     cloud_preview_t m = preview_message(group, config_.preview.cell_m);
+    // Profiles go out in the order they are first placed, not in time (one placed with a loop
+    // closure's moves comes after newer ones): the channel's time stays where it was.
+    preview_utime_ = std::max(preview_utime_, m.utime);
+    m.utime = preview_utime_;
     bus_.publish(config_.preview.channel, m);
     ++preview_messages_;
     preview_sent_bytes_ += m.getEncodedSize();

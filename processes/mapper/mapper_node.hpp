@@ -134,6 +134,7 @@ class MapperNode {
   Mapper mapper_;                          // touched only by the worker (or inline)
   std::unique_ptr<CloudPreview> preview_;  // filled by the worker, published by publish_preview
   double preview_messages_ = 0, preview_sent_bytes_ = 0;
+  int64_t preview_utime_ = 0;  // [us] utime of CLOUD_PREVIEW: never goes backwards
   // What a late viewer is sent (this thread only), and how many bytes of the answer went out in
   // the current pacing window.
   std::unique_ptr<PreviewResend> resend_store_;

@@ -203,6 +203,8 @@ Frame encode_guidance(const Guidance& g) {
                {"loop_target", g.loop_target ? target(*g.loop_target) : json(nullptr)}});
 }
 
-Frame encode_view(double voxel_m) { return text({{"type", "view"}, {"voxel_m", voxel_m}}); }
+Frame encode_view(double voxel_m, double redraw_period_s) {
+  return text({{"type", "view"}, {"voxel_m", voxel_m}, {"redraw_period_s", redraw_period_s}});
+}
 
 }  // namespace traverse::viewer

@@ -6,7 +6,7 @@
 //   poses (kind 2): u8 2, u32 count, then per profile: u32 index, f32 x, f32 y, f32 theta.
 // JSON frames carry "type": "reset" (a snapshot follows: forget everything), "legend",
 // "annotations", "trajectory", "pose", "status", "guidance", "view" (how to draw: the voxels'
-// edge). A snapshot is "reset" followed by the
+// edge, how often the page redraws what the feed changed). A snapshot is "reset" followed by the
 // whole state in the same frames as the changes, so the page has one way to read either.
 #pragma once
 
@@ -36,6 +36,6 @@ std::vector<Frame> encode_snapshot(const Scene& scene);
 Frame encode_status(const StatusBoard& board, int64_t now_utime);
 Frame encode_guidance(const Guidance& guidance);
 // How the page draws what it gets: the edge of its voxels [m].
-Frame encode_view(double voxel_m);
+Frame encode_view(double voxel_m, double redraw_period_s);
 
 }  // namespace traverse::viewer

@@ -14,6 +14,7 @@ std::optional<std::string> validate(const ViewerConfig& c) {
   check.not_empty("pose_channel", c.pose_channel);
   check.not_empty("status_prefix", c.status_prefix);
   check.in_range("update_period_s", c.update_period_s, 0.01, 10.0);
+  check.in_range("redraw_period_s", c.redraw_period_s, 0.0, 10.0);
   check.in_range("trajectory_step_m", c.trajectory_step_m, 0.0, 10.0);
   check.in_range("pose_history_s", c.pose_history_s, 1.0, 3600.0);
   check.in_range("loop_min_age_s", c.loop_min_age_s, 0.0, 86400.0);

@@ -31,6 +31,12 @@ struct ViewerConfig {
   double voxel_m = 0.16;
 
   double update_period_s = 0.2;     // [s] how often changes go to the browsers
+  // [s] the page draws what the feed changed at most this often (what the operator does to the
+  // view is drawn at once; 0: every update). Without a graphics processor a browser draws in
+  // software, about 0.1 s of CPU a drawing on this 2-core machine: headless chromium on the same
+  // machine as the graph took 28.6 s of CPU a minute with 0, 14.5-15.1 s with 0.5
+  // (scripts/viewer-cost.sh --runs browser, office-s2, first 60 s, two runs each).
+  double redraw_period_s = 0.5;
   double trajectory_step_m = 0.05;  // [m] drawn trajectory: poses at least this far apart
   double pose_history_s = 120.0;    // [s] frontend poses kept to tie the newest to the trajectory
   double loop_min_age_s = 30.0;     // [s] a loop-closure target is at least this much older
@@ -50,6 +56,7 @@ struct ViewerConfig {
     v("ask_for_state", ask_for_state);
     v("voxel_m", voxel_m);
     v("update_period_s", update_period_s);
+    v("redraw_period_s", redraw_period_s);
     v("trajectory_step_m", trajectory_step_m);
     v("pose_history_s", pose_history_s);
     v("loop_min_age_s", loop_min_age_s);

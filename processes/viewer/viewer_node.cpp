@@ -127,7 +127,7 @@ void ViewerNode::update(int64_t now_utime) {
   if (server_->snapshot_wanted()) {
     std::vector<Frame> all = encode_snapshot(scene_);
     all.push_back(status);
-    all.push_back(encode_view(config_.voxel_m));
+    all.push_back(encode_view(config_.voxel_m, config_.redraw_period_s));
     if (guidance) all.push_back(*guidance);
     server_->send_snapshot(all);
   }

@@ -236,6 +236,65 @@ TEST_P(GraphTest, ExportColoursPointsByTheNewestAnnotationOfTheirKeyPose) {
   EXPECT_EQ(mapper_counters_.at("annotated_key_poses"), 7.0);
 }
 
+// The preview goes out in the order profiles are first placed, which is not their time order: a
+// profile that reaches back into a segment a loop closure just moved is placed with the moves,
+// after newer profiles. CLOUD_PREVIEW's time still never goes backwards (the monitor calls that a
+// fault), and each profile keeps its own time.
+class OnePointPreviewTest : public GraphTest {
+ protected:
+  void configure(mapper::MapperConfig& c) override { c.preview.max_points_per_message = 1; }
+};
+
+TEST_P(OnePointPreviewTest, PreviewTimeNeverGoesBackWhenAMovePlacesAnOlderProfileLast) {
+  std::vector<cloud_preview_t> preview;  // every message, in any order (the order is checked here)
+  bus_.subscribe<cloud_preview_t>(
+      channels::kCloudPreview, [&](const cloud_preview_t& m) { preview.push_back(m); }, true);
+  drive(3 * kKeyEvery, true);  // key poses 0-3; segment 2 (to key pose 3) closed
+  mapper_->publish_preview();
+  handle_all();
+  // Poses up to key pose 4 and profiles from just before key pose 3 on (30 ms long: the first
+  // spans it), all waiting for segment 3; then key pose 3 moves and key pose 4 arrives in one
+  // optimisation: segment 2 moves, segment 3 closes.
+  for (int i = 3 * kKeyEvery + 1; i <= 4 * kKeyEvery; ++i) {
+    pose2d_t p{};
+    p.utime = kT0 + i * kPoseDt;
+    p.parent_frame = "map";
+    p.child_frame = "base";
+    p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
+    p.y = 0.01;
+    bus_.publish(channels::kPoseFrontend, p);
+  }
+  for (int i = 3 * kKeyEvery - 1; i + 2 <= 4 * kKeyEvery; i += 3) send_profile(kT0 + i * kPoseDt);
+  handle_all();
+  mapper_->flush();
+  send_keys({3, 4}, 0.05);
+  handle_all();
+  mapper_->flush();
+  mapper_->publish_preview();
+  handle_all();
+  // The profile across key pose 3 touches the moved segment: it went out after the newer ones.
+  int64_t newest_profile = 0;
+  bool older_after_newer = false;
+  for (const cloud_preview_t& m : preview) {
+    for (const preview_profile_t& p : m.profiles) {
+      older_after_newer = older_after_newer || p.utime < newest_profile;
+      newest_profile = std::max(newest_profile, p.utime);
+    }
+  }
+  ASSERT_TRUE(older_after_newer);
+  for (std::size_t i = 1; i < preview.size(); ++i) {
+    EXPECT_GE(preview[i].utime, preview[i - 1].utime) << "message " << i;
+  }
+  for (const cloud_preview_t& m : preview) {
+    for (const preview_profile_t& p : m.profiles) EXPECT_LE(p.utime, m.utime);
+  }
+}
+
+// Inline (replay): one message at a time, so the closure's message alone moves segment 2 and
+// closes segment 3 (the worker batches messages as they come).
+INSTANTIATE_TEST_SUITE_P(Mapper, OnePointPreviewTest, ::testing::Values(false),
+                         [](const auto&) { return "inline"; });
+
 INSTANTIATE_TEST_SUITE_P(Mapper, GraphTest, ::testing::Values(true, false),
                          [](const auto& info) { return info.param ? "worker" : "inline"; });
 

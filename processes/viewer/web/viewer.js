@@ -17,7 +17,7 @@ const GREY = [0.5, 0.5, 0.5];
 const state = {
   connected: false, frames: 0, bytes: 0, resets: 0, points: 0, profiles: 0, moves: 0,
   legend: null, annotations: 0, levelCounts: {}, trajectoryPoses: 0, pose: null, guidance: null,
-  processes: [], bottom: null, lastFrameAt: 0, voxels: 0, voxelLevelCounts: {},
+  processes: [], bottom: null, lastFrameAt: 0, voxels: 0, voxelLevelCounts: {}, draws: 0,
 };
 window.viewerState = state;
 
@@ -43,8 +43,14 @@ function makeControls() {
   controls = new OrbitControls(camera, renderer.domElement);
   controls.screenSpacePanning = true;
   controls.enableRotate = camera !== topCamera;
-  controls.addEventListener('change', () => { dirty = true; });
-  controls.addEventListener('start', () => { document.getElementById('follow').checked = false; });
+  // Drawn at once while the operator turns or moves the view; a change the feed makes (following
+  // the cart) waits for the feed's next redraw.
+  controls.addEventListener('change', () => { if (interacting) viewDirty = true; else dirty = true; });
+  controls.addEventListener('start', () => {
+    interacting = true;
+    document.getElementById('follow').checked = false;
+  });
+  controls.addEventListener('end', () => { interacting = false; });
 }
 
 function resize() {
@@ -58,7 +64,7 @@ function resize() {
   topCamera.updateProjectionMatrix();
   perspective.aspect = a;
   perspective.updateProjectionMatrix();
-  dirty = true;
+  viewDirty = true;
 }
 
 // The cloud: one buffer of positions and colours, each profile a run in it.
@@ -253,7 +259,16 @@ const guideLines = new THREE.LineSegments(new THREE.BufferGeometry(),
 scene.add(guideLines);
 
 // --- the feed ----------------------------------------------------------------------------------
-let dirty = true;
+// Two kinds of redraw. What the operator does (turning the view, a toggle, a resize) is drawn at
+// the next animation frame. What the feed changes (new points, colours, the cart, the trajectory)
+// is drawn at most once per redraw period (the viewer's redraw_period_s, sent in its "view"
+// frame): without a graphics processor the browser draws in software, and drawing every update
+// (five a second) took half a core of the graph's own 2-core machine (viewer_config.hpp).
+let dirty = true;      // the feed changed something
+let viewDirty = true;  // the operator changed the view
+let interacting = false;
+let redrawPeriodMs = 500;
+let lastFeedDraw = -Infinity;
 
 function onText(msg) {
   switch (msg.type) {
@@ -297,6 +312,7 @@ function onText(msg) {
       break;
     case 'view':
       voxels.setSize(msg.voxel_m);
+      if (msg.redraw_period_s !== undefined) redrawPeriodMs = 1000 * msg.redraw_period_s;
       break;
   }
   dirty = true;
@@ -489,39 +505,43 @@ $('voxels').onchange = () => {
   const on = $('voxels').checked;
   voxels.show(on);
   cloud.object.visible = !on;
-  dirty = true;
+  viewDirty = true;
 };
 $('bottom').onchange = () => { state.bottom = +$('bottom').value; showGuidance(); };
 window.addEventListener('resize', resize);
 
-function frame() {
-  if (annotationsChanged) {
-    annotationsChanged = false;
-    rebuildKeyIndex();
-    cloud.recolour();
-    redrawKeys();
-    state.annotations = annotations.size;
-    dirty = true;
+function frame(now) {
+  requestAnimationFrame(frame);
+  const feedDue = dirty && now - lastFeedDraw >= redrawPeriodMs;
+  if (feedDue) {
+    dirty = false;
+    lastFeedDraw = now;
+    if (annotationsChanged) {
+      annotationsChanged = false;
+      rebuildKeyIndex();
+      cloud.recolour();
+      redrawKeys();
+      state.annotations = annotations.size;
+    }
+    if (trajectoryChanged) {
+      trajectoryChanged = false;
+      redrawTrajectory();
+    }
+    if (cloud.version !== voxelsBuiltFor) voxels.stale = true;
   }
-  if (trajectoryChanged) {
-    trajectoryChanged = false;
-    redrawTrajectory();
-    dirty = true;
-  }
-  if (cloud.version !== voxelsBuiltFor) voxels.stale = true;
-  if (voxels.update(performance.now())) {
+  const voxelsBuilt = voxels.update(now);
+  if (voxelsBuilt) {
     voxelsBuiltFor = cloud.version;
     state.voxels = voxels.count;
     state.voxelLevelCounts = Object.fromEntries(Object.entries(voxels.levelCounts)
       .map(([level, n]) => [levelName(+level), n]));
-    dirty = true;
   }
-  if (dirty) {
-    dirty = false;
+  if (feedDue || viewDirty || voxelsBuilt) {
+    viewDirty = false;
+    ++state.draws;
     showCounts();
     renderer.render(scene, camera);
   }
-  requestAnimationFrame(frame);
 }
 
 // Where each key pose is drawn now: its level and its pixel in the drawing buffer (origin at the
