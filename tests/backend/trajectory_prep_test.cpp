@@ -20,6 +20,16 @@ std::vector<StampedPose> drive(int n, double vx, double omega) {
   return poses;
 }
 
+// Every pose through `prep`, the one it holds back included.
+std::vector<PreparedPose> prepare_all(TrajectoryPrep& prep, const std::vector<StampedPose>& poses) {
+  std::vector<PreparedPose> out;
+  for (const StampedPose& p : poses) {
+    if (auto q = prep.add({p.utime, p.T_world_base})) out.push_back(*q);
+  }
+  if (auto q = prep.finish()) out.push_back(*q);
+  return out;
+}
+
 TEST(JumpSmoothing, KeepsSmoothMotionUnchanged) {
   for (const auto& poses : {drive(200, 1.2, 0.0), drive(200, 0.8, 0.7), drive(200, 0.0, 0.0)}) {
     const SmoothedTrajectory s = smooth_jumps(poses, {});
@@ -157,11 +167,7 @@ TEST(TrajectoryPrep, StampsSqueezedTogetherAreNotAStream) {
     config.sparse_interval_us = 100000;  // configs/backend.yaml
     config.min_stream_interval_us = min_stream_us;
     TrajectoryPrep prep(config);
-    std::vector<PreparedPose> out;
-    for (const StampedPose& p : poses) {
-      if (auto q = prep.add({p.utime, p.T_world_base})) out.push_back(*q);
-    }
-    if (auto q = prep.finish()) out.push_back(*q);
+    const std::vector<PreparedPose> out = prepare_all(prep, poses);
     ASSERT_EQ(out.size(), poses.size());
     const double error =
         std::abs(wrap_angle(out.back().T_world_base.theta() - poses.back().T_world_base.theta()));
@@ -225,11 +231,7 @@ TEST(TrajectoryPrep, AFrontendFlippingBetweenTwoPlacesIsNotCarriedOffWhenSmoothi
     JumpSmoothingConfig config;
     config.enabled = enabled;
     TrajectoryPrep prep(config);
-    std::vector<PreparedPose> out;
-    for (const StampedPose& p : poses) {
-      if (auto q = prep.add({p.utime, p.T_world_base})) out.push_back(*q);
-    }
-    if (auto q = prep.finish()) out.push_back(*q);
+    const std::vector<PreparedPose> out = prepare_all(prep, poses);
     EXPECT_EQ(out.size(), poses.size());
     return (out.back().T_world_base.translation() - poses.back().T_world_base.translation()).norm();
   };

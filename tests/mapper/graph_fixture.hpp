@@ -81,18 +81,24 @@ class GraphTest : public ::testing::TestWithParam<bool> {
     bus_.publish(channels::kScanProfile, s);
   }
 
-  // Frontend poses first..n_poses 1 cm north of the truth, key poses (the truth) every kKeyEvery.
+  // Frontend pose i, 1 cm north of the truth.
+  void send_frontend_pose(int i) {
+    pose2d_t p{};
+    p.utime = kT0 + i * kPoseDt;
+    p.parent_frame = "map";
+    p.child_frame = "base";
+    p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
+    p.y = 0.01;
+    bus_.publish(channels::kPoseFrontend, p);
+  }
+
+  // Frontend poses first..n_poses, key poses (the truth) every kKeyEvery.
   void drive(int n_poses, bool profiles, int first = 0) {
     for (int i = first; i <= n_poses; ++i) {
-      pose2d_t p{};
-      p.utime = kT0 + i * kPoseDt;
-      p.parent_frame = "map";
-      p.child_frame = "base";
-      p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
-      p.y = 0.01;
-      bus_.publish(channels::kPoseFrontend, p);
+      send_frontend_pose(i);
+      const int64_t utime = kT0 + i * kPoseDt;
       if (i % kKeyEvery == 0) send_keys({i / kKeyEvery}, 0.0);
-      if (profiles && i % 3 == 0 && i + 2 <= n_poses) send_profile(p.utime);
+      if (profiles && i % 3 == 0 && i + 2 <= n_poses) send_profile(utime);
       handle_all();
       mapper_->flush();
     }

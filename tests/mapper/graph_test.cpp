@@ -255,15 +255,7 @@ TEST_P(OnePointPreviewTest, PreviewTimeNeverGoesBackWhenAMovePlacesAnOlderProfil
   // Poses up to key pose 4 and profiles from just before key pose 3 on (30 ms long: the first
   // spans it), all waiting for segment 3; then key pose 3 moves and key pose 4 arrives in one
   // optimisation: segment 2 moves, segment 3 closes.
-  for (int i = 3 * kKeyEvery + 1; i <= 4 * kKeyEvery; ++i) {
-    pose2d_t p{};
-    p.utime = kT0 + i * kPoseDt;
-    p.parent_frame = "map";
-    p.child_frame = "base";
-    p.x = 0.5e-6 * static_cast<double>(p.utime - kT0);
-    p.y = 0.01;
-    bus_.publish(channels::kPoseFrontend, p);
-  }
+  for (int i = 3 * kKeyEvery + 1; i <= 4 * kKeyEvery; ++i) send_frontend_pose(i);
   for (int i = 3 * kKeyEvery - 1; i + 2 <= 4 * kKeyEvery; i += 3) send_profile(kT0 + i * kPoseDt);
   handle_all();
   mapper_->flush();
