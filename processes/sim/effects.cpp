@@ -42,6 +42,11 @@ std::optional<std::string> check_motion(const MotionEffect& m) {
   c.in_range("weave_m", m.weave_m, 0.0, 0.2);
   c.in_range("weave_wavelength_m", m.weave_wavelength_m, 1.0, 100.0);
   c.in_range("spin_turn_min_rad", m.spin_turn_min_rad, 0.5, 3.1416);
+  c.in_range("start_yaw_min_rad", m.start_yaw_min_rad, 0.0, 0.2);
+  c.in_range("start_yaw_max_rad", m.start_yaw_max_rad, 0.0, 0.2);
+  c.require(m.start_yaw_max_rad >= m.start_yaw_min_rad, "start_yaw_max_rad",
+            "must be >= start_yaw_min_rad");
+  c.in_range("start_settle_m", m.start_settle_m, 0.1, 20.0);
   return c.problem();
 }
 

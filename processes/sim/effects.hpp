@@ -41,6 +41,12 @@ struct MotionEffect {
   double weave_m = 0.03;            // [m] 1 sigma lateral weave about the straight line
   double weave_wavelength_m = 8.0;  // [m]
   double spin_turn_min_rad = 2.6;   // [rad] sharper turns (reversals) are turned on the spot
+  // The cart is set down at the route's start by eye, turned from its first leg by a yaw of
+  // magnitude uniform in [min, max] and random sign (the first scan, which fixes the map's frame,
+  // is not square to the walls), and rolls back onto the line over its first start_settle_m.
+  double start_yaw_min_rad = 0.0087;  // [rad] 0.5 deg
+  double start_yaw_max_rad = 0.035;   // [rad] 2 deg
+  double start_settle_m = 2.0;        // [m]
   template <class V>
   void visit(V& v) {
     v("enabled", enabled);
@@ -51,6 +57,9 @@ struct MotionEffect {
     v("weave_m", weave_m);
     v("weave_wavelength_m", weave_wavelength_m);
     v("spin_turn_min_rad", spin_turn_min_rad);
+    v("start_yaw_min_rad", start_yaw_min_rad);
+    v("start_yaw_max_rad", start_yaw_max_rad);
+    v("start_settle_m", start_settle_m);
   }
 };
 

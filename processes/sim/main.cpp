@@ -192,6 +192,7 @@ int main(int argc, char** argv) {
   };
   json["true_extrinsics"]["laser_horizontal"] =
       extrinsic_json(truth.laser_horizontal, rig.laser_horizontal);
+  json["true_start_yaw_rad"] = traverse::json_fixed(truth.start_yaw_rad, 6);
   std::printf("%s\n", traverse::json_line(json).c_str());
   return rc;
 }

@@ -41,8 +41,10 @@ std::vector<PathPiece> fillet_polyline(const std::vector<Eigen::Vector2d>& p, do
 }
 
 PushedRun::PushedRun(std::vector<PathPiece> pieces, double cruise_mps, double accel_mps2,
-                     const MotionEffect& motion, Rng& rng)
-    : pieces_(std::move(pieces)) {
+                     const MotionEffect& motion, Rng& rng, double start_yaw_rad)
+    : pieces_(std::move(pieces)),
+      lead_in_slope_(std::tan(start_yaw_rad)),
+      lead_in_m_(motion.start_settle_m) {
   if (pieces_.empty()) throw std::runtime_error("pushed run without a path");
   for (const auto& piece : pieces_) {
     piece_s0_.push_back(length_);
@@ -108,7 +110,16 @@ double PushedRun::weave(double s, double& slope) const {
   };
   const double h = 1e-3;
   slope = (w(std::min(s + h, length_)) - w(std::max(s - h, 0.0))) / (2.0 * h);
-  return w(s);
+  // The start yaw's lead-in: y = tan(yaw) s (1 - s / L)^2, slope tan(yaw) at s = 0, back on
+  // the line with slope 0 at s = L.
+  const double L = std::min(lead_in_m_, length_);
+  double lead = 0.0;
+  if (s < L) {
+    const double r = 1.0 - s / L;
+    lead = lead_in_slope_ * s * r * r;
+    slope += lead_in_slope_ * r * (1.0 - 3.0 * s / L);
+  }
+  return w(s) + lead;
 }
 
 Pose2 PushedRun::pose_at(double s) const {

@@ -24,9 +24,11 @@ struct PathPiece {
 // One continuous drive from standstill to standstill.
 class PushedRun {
  public:
-  // Throws std::runtime_error for an empty path. `rng` draws the speed and weave phases.
+  // Throws std::runtime_error for an empty path. `rng` draws the speed and weave phases. The cart
+  // starts turned by start_yaw_rad from the path and rolls back onto it over
+  // motion.start_settle_m (a lateral lead-in y = tan(yaw) s (1 - s / L)^2 on top of the weave).
   PushedRun(std::vector<PathPiece> pieces, double cruise_mps, double accel_mps2,
-            const MotionEffect& motion, Rng& rng);
+            const MotionEffect& motion, Rng& rng, double start_yaw_rad = 0.0);
 
   double duration_s() const { return t_.back(); }
   double length_m() const { return length_; }
@@ -45,6 +47,8 @@ class PushedRun {
   double ds_ = 0.02;           // [m] grid of the speed profile
   std::vector<double> v_, t_;  // [m/s], [s] at s = k * ds_
   double weave_amp_[2] = {0, 0}, weave_k_[2] = {0, 0}, weave_phase_[2] = {0, 0};
+  double lead_in_slope_ = 0.0;  // tan of the start yaw
+  double lead_in_m_ = 1.0;      // [m] L
 };
 
 // The corner arcs of a polyline: pieces from p[0] to p.back() with every interior corner turned

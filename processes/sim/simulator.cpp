@@ -25,7 +25,8 @@ enum Stream : uint64_t {
   kFloorStream = 11,
   kHorizontalEffects = 12,
   kProfileEffects = 13,
-  kOdometryStream = 14
+  kOdometryStream = 14,
+  kStartYawStream = 15
 };
 
 // A distinct seed per stream for generators that take a seed and key their own draws.
@@ -97,7 +98,8 @@ Simulator::Simulator(const WorldSpec& world, const RouteSpec& route, const RigCo
     : rig_(rig),
       effects_(effects),
       trajectory_rng_(seed, kTrajectoryStream),
-      trajectory_(checked(route, world), platform, trajectory_rng_, effects),
+      trajectory_(checked(route, world), platform, trajectory_rng_, effects,
+                  draw_start_yaw(effects.motion, Rng(seed, kStartYawStream))),
       clock_{start_utime},
       horizontal_model_(find_horizontal_model(rig, route.horizontal_scanner)) {
   if (rig.ground_truth_rate_hz <= 0 || rig.imu_model.rate_hz <= 0)
@@ -122,6 +124,7 @@ Simulator::Simulator(const WorldSpec& world, const RouteSpec& route, const RigCo
   if (effects.beams.surface.enabled)
     surface_ =
         std::make_unique<SurfaceModel>(effects.beams.surface, stream_seed(seed, kSurfaceStream));
+  truth_.start_yaw_rad = trajectory_.start_yaw_rad();
   // This run's true extrinsics and clocks.
   Rng calib(seed, kCalibrationStream);
   truth_.laser_horizontal = perturb_extrinsic(rig.laser_horizontal, effects.calibration, calib);

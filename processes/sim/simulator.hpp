@@ -70,6 +70,7 @@ struct RunTruth {
   Extrinsic laser_horizontal, laser_profile, imu;  // true T_base_sensor
   SensorClock horizontal_clock, profile_clock, imu_clock, odometry_clock;
   std::map<std::string, double> swap_times;  // [s] movable group -> time it changes
+  double start_yaw_rad = 0.0;  // [rad] the cart set down turned from its first leg (draw_start_yaw)
 };
 
 class Simulator {

@@ -68,9 +68,15 @@ std::vector<Waypoint> expand_route(const RouteSpec& route, const std::vector<std
   return out;
 }
 
+double draw_start_yaw(const MotionEffect& motion, Rng rng) {
+  if (!motion.enabled) return 0.0;
+  const double sign = rng.bernoulli(0.5) ? 1.0 : -1.0;
+  return sign * rng.uniform(motion.start_yaw_min_rad, motion.start_yaw_max_rad);
+}
+
 Trajectory::Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng,
-                       const Effects& effects)
-    : platform_(platform) {
+                       const Effects& effects, double start_yaw_rad)
+    : platform_(platform), start_yaw_rad_(effects.motion.enabled ? start_yaw_rad : 0.0) {
   if (route.waypoints.size() < 2) throw std::runtime_error("route needs at least 2 waypoints");
   if (route.speed_mps <= 0.0 || platform.accel_mps2 <= 0.0 || platform.yaw_rate_radps <= 0.0 ||
       platform.yaw_accel_radps2 <= 0.0)
@@ -84,7 +90,7 @@ Trajectory::Trajectory(const RouteSpec& route, const PlatformConfig& platform, R
     axes_.push_back(vib.axis == "x" ? 0 : vib.axis == "y" ? 1 : 2);
   }
   if (effects.motion.enabled)
-    plan_pushed(route, wp, effects.motion, rng);
+    plan_pushed(route, wp, effects.motion, rng, start_yaw_rad);
   else
     plan_stop_and_turn(route, wp);
   if (segments_.empty()) throw std::runtime_error("route has no motion");
@@ -100,10 +106,10 @@ double leg_heading(const std::vector<Waypoint>& wp, std::size_t i) {
 
 }  // namespace
 
-Pose2 Trajectory::start(const RouteSpec& route, const std::vector<Waypoint>& wp) {
+Pose2 Trajectory::start(const RouteSpec& route, const std::vector<Waypoint>& wp, double yaw) {
   const double heading =
       route.start_heading_rad < 1e8 ? route.start_heading_rad : leg_heading(wp, 0);
-  const Pose2 pose(wp[0].p.x(), wp[0].p.y(), heading);
+  const Pose2 pose(wp[0].p.x(), wp[0].p.y(), wrap_angle(heading + yaw));
   add(Kind::kPause, pose, route.start_pause_s, 0, 0);
   return pose;
 }
@@ -137,12 +143,17 @@ void Trajectory::add_run(PushedRun run, const Pose2& start) {
 }
 
 void Trajectory::plan_pushed(const RouteSpec& route, const std::vector<Waypoint>& wp,
-                             const MotionEffect& motion, Rng& rng) {
+                             const MotionEffect& motion, Rng& rng, double start_yaw_rad) {
   // Runs between stops: a waypoint where the route pauses, or a reversal sharper than
   // spin_turn_min_rad, ends a run; the cart then turns on the spot towards the next leg.
   auto heading_of = [&](std::size_t i) { return leg_heading(wp, i); };
-  Pose2 pose = start(route, wp);
-  double heading = pose.theta();
+  Pose2 pose = start(route, wp, start_yaw_rad);
+  // Set down along its first leg, the cart rolls back onto the line (the first run's lead-in);
+  // set down facing elsewhere, it turns on the spot towards the leg, its yaw included.
+  const bool along_first_leg =
+      std::abs(wrap_angle(pose.theta() - start_yaw_rad - heading_of(0))) < 1e-9;
+  double lead_in_yaw = along_first_leg ? start_yaw_rad : 0.0;
+  double heading = wrap_angle(pose.theta() - lead_in_yaw);
   std::size_t first = 0;
   for (std::size_t i = 1; i < wp.size(); ++i) {
     const bool last = i + 1 == wp.size();
@@ -156,7 +167,8 @@ void Trajectory::plan_pushed(const RouteSpec& route, const std::vector<Waypoint>
     std::vector<Eigen::Vector2d> pts;
     for (std::size_t k = first; k <= i; ++k) pts.push_back(wp[k].p);
     PushedRun run(fillet_polyline(pts, motion.corner_radius_m), route.speed_mps,
-                  platform_.accel_mps2, motion, rng);
+                  platform_.accel_mps2, motion, rng, lead_in_yaw);
+    lead_in_yaw = 0.0;
     const Pose2 start(wp[first].p.x(), wp[first].p.y(), heading);
     add_run(std::move(run), start);
     heading = heading_of(i - 1);

@@ -112,12 +112,15 @@ class Trajectory {
  public:
   // Throws std::runtime_error for an unusable route (fewer than 2 waypoints, bad speed).
   // `rng` draws the vibration phases (and the pushed cart's speed and weave). `effects` selects
-  // the motion (pushed or stop-and-turn) and the detours of its world layers.
+  // the motion (pushed or stop-and-turn) and the detours of its world layers. A pushed cart is
+  // set down turned by `start_yaw_rad` from the route's start heading (draw_start_yaw) and rolls
+  // back onto its first leg over motion.start_settle_m.
   Trajectory(const RouteSpec& route, const PlatformConfig& platform, Rng& rng,
-             const Effects& effects = Effects{}.ideal());
+             const Effects& effects = Effects{}.ideal(), double start_yaw_rad = 0.0);
 
   double duration_s() const { return segments_.empty() ? 0.0 : segments_.back().t1; }
   double length_m() const { return length_m_; }  // [m] driven on straight legs
+  double start_yaw_rad() const { return start_yaw_rad_; }  // [rad] as set down (constructor)
 
   // True pose T_world_base at t [s] since the start (clamped to [0, duration]).
   Pose2 pose(double t) const;
@@ -152,11 +155,12 @@ class Trajectory {
   };
   State nominal_state(double t) const;
   void add(Kind kind, const Pose2& start, double amount, double vmax, double accel);
-  // Adds the start pause; returns the starting pose.
-  Pose2 start(const RouteSpec& route, const std::vector<Waypoint>& wp);
+  // Adds the start pause, the cart turned by yaw [rad] from the route's start heading; returns
+  // the starting pose.
+  Pose2 start(const RouteSpec& route, const std::vector<Waypoint>& wp, double yaw = 0.0);
   void plan_stop_and_turn(const RouteSpec& route, const std::vector<Waypoint>& wp);
   void plan_pushed(const RouteSpec& route, const std::vector<Waypoint>& wp,
-                   const MotionEffect& motion, Rng& rng);
+                   const MotionEffect& motion, Rng& rng, double start_yaw_rad);
   void add_run(PushedRun run, const Pose2& start);
 
   std::vector<PushedRun> runs_;
@@ -167,7 +171,12 @@ class Trajectory {
   std::vector<int> axes_;  // 0 x, 1 y, 2 yaw per vibration component
   double length_m_ = 0.0;
   double dist_ = 0.0;
+  double start_yaw_rad_ = 0.0;
 };
+
+// The yaw [rad] a pushed cart is set down with against its route's start heading: magnitude
+// uniform in [motion.start_yaw_min_rad, start_yaw_max_rad], random sign; 0 with motion off.
+double draw_start_yaw(const MotionEffect& motion, Rng rng);
 
 // Trapezoidal profile over `amount` (>= 0) with top rate vmax and acceleration a: duration and
 // the travelled amount and rate at time tau.

@@ -3,7 +3,7 @@
 # simulator's lab-loop route (seed 1, realistic profile, a SICK LMS200 at 75 Hz, every 30th
 # profile of the tilted scanner), without the 3D ground truth (nothing in the graph reads it).
 # The simulator gives the same bytes for the same inputs; run from the repository root after a
-# change to the simulator or its configs, then tests/regression/update_reference.sh.
+# change to the simulator or its configs, then tests/regression/replay_test.py --update.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 tmp="$(mktemp -d)"

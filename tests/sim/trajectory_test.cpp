@@ -70,7 +70,7 @@ TEST(Routes, StayInFreeSpace) {
       WorldSpec spec;
       load_config("configs/worlds/" + r.world + ".yaml", spec);
       Rng rng(1);
-      const Trajectory traj(r, platform, rng, fx);
+      const Trajectory traj(r, platform, rng, fx, draw_start_yaw(fx.motion, Rng(1, 15)));
       // The world of the profile's layers, with movables where they are at each moment.
       WorldOptions opt;
       opt.layers = fx.world_layers;
@@ -109,6 +109,63 @@ TEST(Trajectory, GroundTruthIsContinuousAndStartsAndEndsAtRest) {
   const Pose2 end = traj.pose(traj.duration_s());
   EXPECT_NEAR(end.x(), r.waypoints.back()[0], 1e-9);
   EXPECT_NEAR(end.y(), r.waypoints.back()[1], 1e-9);
+}
+
+// Set down turned from its first leg, the pushed cart starts with that heading where it was set
+// down and rolls back onto the very path it would have taken, at the same times, within
+// start_settle_m.
+TEST(Trajectory, APushedCartSetDownTurnedRollsBackOntoItsLine) {
+  PlatformConfig platform;
+  const Effects realistic;
+  const RouteSpec r = load_route("office-s2");
+  const double yaw = 0.03;
+  Rng rng_square(1), rng_turned(1);
+  const Trajectory square(r, platform, rng_square, realistic, 0.0);
+  const Trajectory turned(r, platform, rng_turned, realistic, yaw);
+  ASSERT_DOUBLE_EQ(square.duration_s(), turned.duration_s());
+  EXPECT_NEAR(wrap_angle(turned.nominal_pose(0.0).theta() - square.nominal_pose(0.0).theta()),
+              yaw, 1e-9);
+  EXPECT_NEAR((turned.nominal_pose(0.0).translation() - square.nominal_pose(0.0).translation())
+                  .norm(),
+              0.0, 1e-12);
+  // Where the cart has rolled start_settle_m along its line, the two are one path.
+  const double settle = realistic.motion.start_settle_m;
+  double worst_lateral = 0.0, t_settled = -1.0;
+  for (double t = 0.0; t <= square.duration_s(); t += 0.01) {
+    const Pose2 a = square.nominal_pose(t), b = turned.nominal_pose(t);
+    const double apart = (a.translation() - b.translation()).norm();
+    const double travelled = (a.translation() - square.nominal_pose(0.0).translation()).norm();
+    if (travelled < settle - 0.05) {
+      worst_lateral = std::max(worst_lateral, apart);
+      // The heading turns back towards the line's as the cart rolls on.
+      if (travelled > 0.5 * settle) {
+        EXPECT_LT(std::abs(wrap_angle(b.theta() - a.theta())), yaw);
+      }
+    } else if (travelled > settle + 0.05) {
+      if (t_settled < 0.0) t_settled = t;
+      EXPECT_NEAR(apart, 0.0, 1e-9) << "t " << t;
+      EXPECT_NEAR(wrap_angle(b.theta() - a.theta()), 0.0, 1e-9) << "t " << t;
+    }
+  }
+  ASSERT_GT(t_settled, 0.0);
+  // y = tan(yaw) s (1 - s / L)^2 is largest at s = L / 3: 4 / 27 L tan(yaw), 8.9 mm here.
+  EXPECT_GT(worst_lateral, 0.5 * 4.0 / 27.0 * settle * std::tan(yaw));
+  EXPECT_LT(worst_lateral, 1.01 * 4.0 / 27.0 * settle * std::tan(yaw));
+}
+
+TEST(Trajectory, StartYawsAreDrawnInTheirRangeWithBothSigns) {
+  const Effects realistic;
+  const MotionEffect& m = realistic.motion;
+  int positive = 0;
+  for (uint64_t seed = 1; seed <= 200; ++seed) {
+    const double yaw = draw_start_yaw(m, Rng(seed, 15));
+    EXPECT_GE(std::abs(yaw), m.start_yaw_min_rad);
+    EXPECT_LE(std::abs(yaw), m.start_yaw_max_rad);
+    positive += yaw > 0.0;
+  }
+  EXPECT_GT(positive, 70);
+  EXPECT_LT(positive, 130);
+  EXPECT_EQ(draw_start_yaw(realistic.ideal().motion, Rng(1, 15)), 0.0);
 }
 
 TEST(Trajectory, VibratesByAFewMillimetresAroundTheNominalPath) {
