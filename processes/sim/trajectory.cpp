@@ -90,7 +90,7 @@ Trajectory::Trajectory(const RouteSpec& route, const PlatformConfig& platform, R
     axes_.push_back(vib.axis == "x" ? 0 : vib.axis == "y" ? 1 : 2);
   }
   if (effects.motion.enabled)
-    plan_pushed(route, wp, effects.motion, rng, start_yaw_rad);
+    plan_pushed(route, wp, effects.motion, rng);
   else
     plan_stop_and_turn(route, wp);
   if (segments_.empty()) throw std::runtime_error("route has no motion");
@@ -143,17 +143,17 @@ void Trajectory::add_run(PushedRun run, const Pose2& start) {
 }
 
 void Trajectory::plan_pushed(const RouteSpec& route, const std::vector<Waypoint>& wp,
-                             const MotionEffect& motion, Rng& rng, double start_yaw_rad) {
+                             const MotionEffect& motion, Rng& rng) {
   // Runs between stops: a waypoint where the route pauses, or a reversal sharper than
   // spin_turn_min_rad, ends a run; the cart then turns on the spot towards the next leg.
   auto heading_of = [&](std::size_t i) { return leg_heading(wp, i); };
-  Pose2 pose = start(route, wp, start_yaw_rad);
+  Pose2 pose = start(route, wp, start_yaw_rad_);
   // Set down along its first leg, the cart rolls back onto the line (the first run's lead-in);
   // set down facing elsewhere, it turns on the spot towards the leg, its yaw included.
-  const bool along_first_leg =
-      std::abs(wrap_angle(pose.theta() - start_yaw_rad - heading_of(0))) < 1e-9;
-  double lead_in_yaw = along_first_leg ? start_yaw_rad : 0.0;
-  double heading = wrap_angle(pose.theta() - lead_in_yaw);
+  const double set_down_along = wrap_angle(pose.theta() - start_yaw_rad_);
+  const bool along_first_leg = std::abs(wrap_angle(set_down_along - heading_of(0))) < 1e-9;
+  double lead_in_yaw = along_first_leg ? start_yaw_rad_ : 0.0;
+  double heading = along_first_leg ? set_down_along : pose.theta();
   std::size_t first = 0;
   for (std::size_t i = 1; i < wp.size(); ++i) {
     const bool last = i + 1 == wp.size();

@@ -160,7 +160,7 @@ class Trajectory {
   Pose2 start(const RouteSpec& route, const std::vector<Waypoint>& wp, double yaw = 0.0);
   void plan_stop_and_turn(const RouteSpec& route, const std::vector<Waypoint>& wp);
   void plan_pushed(const RouteSpec& route, const std::vector<Waypoint>& wp,
-                   const MotionEffect& motion, Rng& rng, double start_yaw_rad);
+                   const MotionEffect& motion, Rng& rng);
   void add_run(PushedRun run, const Pose2& start);
 
   std::vector<PushedRun> runs_;
