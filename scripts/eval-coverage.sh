@@ -17,7 +17,7 @@
 #                    NEES (e^T Sigma^-1 e with the backend's covariances) lie inside the chi-square
 #                    95 % quantile of two degrees of freedom, q95(NEES) / 5.991
 #   --runs LIST      runs to evaluate (default: the fitting runs and the held-out runs below)
-#   --fit-runs LIST  runs the scale is fitted on (default court-loop:1,office-s1:1)
+#   --fit-runs LIST  runs the scale is fitted on (default court-loop:1,office-s1:1,office-s2:1)
 #   --keep-logs      keep each run's full log and simulated log (by default only a compact log of
 #                    what the evaluation reads is kept, out/eval/<run>/coverage.lcmlog: a full
 #                    office run is over a gigabyte)
@@ -35,9 +35,9 @@ set -euo pipefail
 # shellcheck source=scripts/eval-common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/eval-common.sh"
 
-fit="" keep="" reuse="" wheels="" profile=realistic tag="" sets=() fit_runs="court-loop:1,office-s1:1"
+fit="" keep="" reuse="" wheels="" profile=realistic tag="" sets=() fit_runs="court-loop:1,office-s1:1,office-s2:1"
 runs=""
-held_out="court-loop:2,court-loop:3,corridor-return:1,office-s2:1,office-s3:2"
+held_out="court-loop:2,court-loop:3,corridor-return:1,office-s3:2,office-x1:1,office-x2:2"
 while (($#)); do
   case "$1" in
     --fit) fit=1; shift ;;

@@ -40,6 +40,7 @@ std::optional<std::string> validate(const BackendConfig& c) {
   check.not_negative("frame_heading_sigma_rad", c.frame_heading_sigma_rad);
   check.not_negative("key_pose_sigma_xy_m", c.key_pose_sigma_xy_m);
   check.positive("marginal_scale", c.marginal_scale);
+  check.positive("marginal_frontend_scale", c.marginal_frontend_scale);
   check.nested("boresight", validate(c.boresight));
   check.nested("start_frame", validate(c.start_frame));
   check.nested("odometry", validate(c.odometry));
@@ -131,7 +132,7 @@ Eigen::Matrix3d Backend::published_covariance(int i) const {
       boresight_.yaw_rad() ? boresight_.yaw_sigma_rad() : config_.frame_heading_sigma_rad;
   const double sp = config_.key_pose_sigma_xy_m;
   const Eigen::Matrix3d in_frame =
-      rotate_covariance(key_poses_[i].covariance,
+      rotate_covariance(key_poses_[i].calibrated_covariance,
                         Pose2(0.0, 0.0, -start_frame_.heading_rad().value_or(0.0)).rotation());
   return config_.marginal_scale * boresight_.published(in_frame) + sf * sf * J * J.transpose() +
          Eigen::Vector3d(sp * sp, sp * sp, 0.0).asDiagonal().toDenseMatrix();
@@ -233,6 +234,7 @@ void Backend::add_key_pose(const PlanarScan& scan) {
     }
     if (frontend) add_frontend_edges(index, step.odometry);
     key.covariance = key_poses_.back().covariance;  // until the next optimisation
+    key.calibrated_covariance = key_poses_.back().calibrated_covariance;
     // A step netted over a spike is not the start of another.
     step_before_from_odometry_.reset();
     if (step.odometry && !step.netted) step_before_from_odometry_ = step.odometry->motion;
@@ -271,6 +273,18 @@ void Backend::add_closure(LoopClosure closure) {
   closures_.push_back(closure);
 }
 
+PoseGraph Backend::calibrated_graph() const {
+  PoseGraph graph = graph_;
+  for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+    const EdgeKind kind = edge_kinds_[k];
+    if (kind == EdgeKind::kFrontend || kind == EdgeKind::kFrontendDrift ||
+        kind == EdgeKind::kFrontendPose) {
+      graph.edges[k].information /= config_.marginal_frontend_scale;
+    }
+  }
+  return graph;
+}
+
 std::optional<BackendUpdate> Backend::optimise() {
   BackendUpdate update;
   const auto t0 = std::chrono::steady_clock::now();
@@ -278,11 +292,17 @@ std::optional<BackendUpdate> Backend::optimise() {
   update.optimisation_s = seconds_since(t0);
   const auto t1 = std::chrono::steady_clock::now();
   const auto marginals = spa_.marginals(graph_);
+  std::optional<std::vector<Eigen::Matrix3d>> calibrated = marginals;
+  if (config_.marginal_frontend_scale != 1.0) {
+    PoseGraph graph = calibrated_graph();
+    calibrated = spa_.marginals(graph);
+  }
   update.marginals_s = seconds_since(t1);
   std::vector<Pose2> poses(key_poses_.size());
   for (int i = 0; i < static_cast<int>(key_poses_.size()); ++i) {
     key_poses_[i].T_world_base = poses[i] = graph_.poses[key_vertex(i)];
     if (marginals) key_poses_[i].covariance = (*marginals)[key_vertex(i)];
+    if (calibrated) key_poses_[i].calibrated_covariance = (*calibrated)[key_vertex(i)];
   }
   boresight_.update(poses);
   std::vector<double> travel(key_poses_.size());

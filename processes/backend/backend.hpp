@@ -125,6 +125,16 @@ struct BackendConfig {
   // does not move its optimum; the loop closer's check keeps the unscaled marginals, so nothing
   // the backend estimates changes with it.
   double marginal_scale = 1.0;  // [unitless]
+  // The published marginals come from the graph at its optimum with every edge of the frontend's
+  // chain (kFrontend, kFrontendDrift, kFrontendPose) this many times less informative than the
+  // optimisation weighs it (a variance factor; the links and closures as they are, their scales
+  // are fitted against real references). The frontend's published covariances are far too small
+  // against its real error (configs/backend.yaml), so in the graph as optimised its chain
+  // outweighs any closure and a closure cannot shrink a marginal; scaled after the fact
+  // (marginal_scale) the marginals then stay as large after a closure as before. Computed on a
+  // copy of the graph's information, so neither the optimum nor the loop closer's check (which
+  // keeps KeyPose::covariance) moves. 1: the graph's own marginals, one factorisation fewer.
+  double marginal_frontend_scale = 1.0;  // [unitless]
   // The horizontal scanner's yaw on the cart, estimated from the key poses and applied to every
   // published key pose (boresight.hpp).
   BoresightConfig boresight;
@@ -166,6 +176,7 @@ struct BackendConfig {
     v("frame_heading_sigma_rad", frame_heading_sigma_rad);
     v("key_pose_sigma_xy_m", key_pose_sigma_xy_m);
     v("marginal_scale", marginal_scale);
+    v("marginal_frontend_scale", marginal_frontend_scale);
     v("boresight", boresight);
     v("start_frame", start_frame);
     v("odometry", odometry);
@@ -187,6 +198,9 @@ struct KeyPose {
   // Marginal covariance of (x [m], y [m], theta [rad]) in the world frame: m^2, m rad, rad^2.
   // Zero for the first key pose (it fixes the gauge).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  // The same with the frontend's chain at marginal_frontend_scale (BackendConfig): what is
+  // published (Backend::published_covariance).
+  Eigen::Matrix3d calibrated_covariance = Eigen::Matrix3d::Zero();
 };
 
 // What an edge of the backend's graph measures.
@@ -279,8 +293,8 @@ class Backend {
   // first key scan (start_frame.hpp), then its position by the scanner's boresight (boresight.hpp),
   // each when it is estimated; the same pose otherwise.
   Pose2 published_pose(int i) const;
-  // Key pose i's covariance as published: its marginal (KeyPose::covariance, which the loop
-  // closer's check uses) times marginal_scale, with the frame's heading (frame_heading_sigma_rad,
+  // Key pose i's covariance as published: its calibrated marginal (KeyPose::
+  // calibrated_covariance; the loop closer's check uses KeyPose::covariance) times marginal_scale, with the frame's heading (frame_heading_sigma_rad,
   // or the boresight estimate's standard deviation while it is applied) and the key pose's own
   // error (key_pose_sigma_xy_m); in the published frame. Zero for the first key pose.
   Eigen::Matrix3d published_covariance(int i) const;
@@ -305,6 +319,8 @@ class Backend {
   bool frontend_edges() const {
     return config_.frontend_sigma_xy_m > 0.0 && config_.frontend_sigma_theta_rad > 0.0;
   }
+  // A copy of the graph with the frontend's chain at marginal_frontend_scale.
+  PoseGraph calibrated_graph() const;
   // Adds the key pose at the newest prepared pose with the points of `scan`.
   void add_key_pose(const PlanarScan& scan);
   // The frontend's covariances of the last key pose and the newest prepared pose, each in its own

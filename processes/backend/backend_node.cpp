@@ -158,8 +158,12 @@ void BackendNode::publish_edges(std::size_t first, std::size_t last, int32_t opt
       m.x = e.T_from_to.x();
       m.y = e.T_from_to.y();
       m.theta = e.T_from_to.theta();
-      // The edges as the published marginals see them (BackendConfig::marginal_scale).
-      copy_matrix(e.information / backend_.config().marginal_scale, m.information);
+      // The edges as the published marginals see them (BackendConfig::marginal_scale, and
+      // marginal_frontend_scale on the frontend's).
+      const BackendConfig& c = backend_.config();
+      const double scale =
+          c.marginal_scale * (e.kind == EdgeKind::kFrontend ? c.marginal_frontend_scale : 1.0);
+      copy_matrix(e.information / scale, m.information);
       msg.edges.push_back(m);
     }
     msg.n_edges = static_cast<int32_t>(msg.edges.size());

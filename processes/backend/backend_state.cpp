@@ -7,7 +7,7 @@
 namespace traverse::backend {
 namespace {
 
-const std::string kMagic = "TRVBKG02";  // graph.state, version 2 (closures without second_peak)
+const std::string kMagic = "TRVBKG03";  // graph.state, version 3 (calibrated marginals)
 // Bounds on what a snapshot may claim, so a damaged count cannot allocate without end.
 constexpr uint64_t kMaxItems = 50'000'000;
 
@@ -62,6 +62,7 @@ std::string BackendStateStore::snapshot(const Backend& b) const {
     w.put(k.T_world_base);
     w.put(k.travel_m);
     put(w, k.covariance);
+    put(w, k.calibrated_covariance);
   }
   const PoseGraph& g = b.graph_;
   w.put<uint64_t>(g.poses.size());
@@ -113,7 +114,8 @@ std::optional<ResumedState> BackendStateStore::resume(Backend& b) {
     throw damaged();
   b.key_poses_.resize(n);
   for (KeyPose& k : b.key_poses_) {
-    if (!r.get(k.utime) || !r.get(k.T_world_base) || !r.get(k.travel_m) || !get(r, k.covariance))
+    if (!r.get(k.utime) || !r.get(k.T_world_base) || !r.get(k.travel_m) || !get(r, k.covariance) ||
+        !get(r, k.calibrated_covariance))
       throw damaged();
   }
   PoseGraph& g = b.graph_;

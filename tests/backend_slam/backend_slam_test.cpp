@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <cstdio>
 #include <map>
 
 #include "backend.hpp"
@@ -143,6 +144,70 @@ TEST(Backend, PublishedCovarianceAddsTheFramesHeadingAndTheKeyPosesOwnError) {
     EXPECT_NEAR(across.dot(P * across), 0.004 * 0.004 * r.squaredNorm() + 1e-4, 1e-12);
     EXPECT_NEAR(along.dot(P * along), 1e-4, 1e-12);
     EXPECT_NEAR(added(2, 2), 0.004 * 0.004, 1e-15);
+  }
+}
+
+// A frontend that claims far more than it holds (the office cart's fallback sigmas, 1 mm and
+// 5e-6 rad, with the drift model): in the graph as optimised its chain outweighs every closure, so
+// a closure leaves the key poses' marginals as they were, and scaled after the fact
+// (marginal_scale) they stay as large after it. With the chain's edges at marginal_frontend_scale
+// the marginals are made from a graph in which a closure weighs what it measures: the key poses
+// it ties back get smaller marginals. Neither the optimum nor the graph's own marginals (the loop
+// closer's) move.
+TEST(Backend, AClosureLowersTheCalibratedMarginalsNearIt) {
+  test::Drive d = test::drive_ellipse(25.0);
+  d.input = d.truth;  // the frontend is right; it only claims too much
+  BackendConfig plain;
+  plain.frontend_sigma_xy_m = 0.001;
+  plain.frontend_sigma_theta_rad = 5e-6;
+  plain.frontend_drift_length_m = 20.0;
+  BackendConfig calibrated = plain;
+  calibrated.marginal_frontend_scale = 400.0;
+  ASSERT_EQ(validate(calibrated), std::nullopt);
+  Backend a(plain), b(calibrated);
+  // The published covariance's trace of position of key pose i [m^2].
+  const auto trace = [](const Backend& backend, int i) {
+    return backend.published_covariance(i).topLeftCorner<2, 2>().trace();
+  };
+  struct Drop {
+    double plain = 0.0, calibrated = 0.0;  // after / before, at the key pose the closure ends on
+    int closures = 0;
+  } drop;
+  for (std::size_t k = 0; k < d.utimes.size(); ++k) {
+    a.add_scan(d.scans[k]);
+    b.add_scan(d.scans[k]);
+    const int keys_before = static_cast<int>(b.key_poses().size());
+    std::vector<double> before_a, before_b;
+    for (int i = 0; i < keys_before; ++i) {
+      before_a.push_back(trace(a, i));
+      before_b.push_back(trace(b, i));
+    }
+    const auto ua = a.add_pose(d.utimes[k], d.input[k]);
+    const auto ub = b.add_pose(d.utimes[k], d.input[k]);
+    ASSERT_EQ(ua.has_value(), ub.has_value());
+    if (!ub || ub->new_closures.empty() || drop.closures > 0) continue;
+    ASSERT_EQ(ua->new_closures.size(), ub->new_closures.size());
+    // The closure's newer key pose had a marginal before it (it ends on an older key pose).
+    const int i = ub->new_closures.front().to;
+    ASSERT_LT(i, keys_before);
+    drop.plain = trace(a, i) / before_a[i];
+    drop.calibrated = trace(b, i) / before_b[i];
+    ++drop.closures;
+  }
+  a.finish();
+  b.finish();
+  ASSERT_EQ(drop.closures, 1);
+  std::printf("the first closure's key pose: position variance after / before %.3f (graph's own), "
+              "%.3f (frontend's chain at 400 for the marginals)\n",
+              drop.plain, drop.calibrated);
+  EXPECT_GT(drop.plain, 0.9) << "the over-confident chain outweighs the closure";
+  EXPECT_LT(drop.calibrated, 0.5) << "the closure lowers the calibrated marginal";
+  ASSERT_EQ(a.key_poses().size(), b.key_poses().size());
+  for (std::size_t i = 0; i < a.key_poses().size(); ++i) {
+    const KeyPose& ka = a.key_poses()[i];
+    const KeyPose& kb = b.key_poses()[i];
+    EXPECT_EQ((ka.T_world_base.translation() - kb.T_world_base.translation()).norm(), 0.0);
+    EXPECT_EQ((ka.covariance - kb.covariance).norm(), 0.0);
   }
 }
 
