@@ -276,9 +276,7 @@ void Backend::add_closure(LoopClosure closure) {
 PoseGraph Backend::calibrated_graph() const {
   PoseGraph graph = graph_;
   for (std::size_t k = 0; k < graph.edges.size(); ++k) {
-    const EdgeKind kind = edge_kinds_[k];
-    if (kind == EdgeKind::kFrontend || kind == EdgeKind::kFrontendDrift ||
-        kind == EdgeKind::kFrontendPose) {
+    if (frontend_chain(edge_kinds_[k])) {
       graph.edges[k].information /= config_.marginal_frontend_scale;
     }
   }

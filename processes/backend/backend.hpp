@@ -212,6 +212,12 @@ enum class EdgeKind {
   kClosure,        // a loop closure
 };
 
+// Whether an edge of this kind carries the frontend's trajectory (marginal_frontend_scale).
+inline bool frontend_chain(EdgeKind kind) {
+  return kind == EdgeKind::kFrontend || kind == EdgeKind::kFrontendDrift ||
+         kind == EdgeKind::kFrontendPose;
+}
+
 // An edge between two key poses (key pose indices, not graph vertices), as published
 // (backend_node.hpp): links and closures as in the graph; the frontend's edges of a key step (with
 // the drift model: the drifting frontend's step and its pose edge) as one edge of the frontend's
@@ -294,9 +300,10 @@ class Backend {
   // each when it is estimated; the same pose otherwise.
   Pose2 published_pose(int i) const;
   // Key pose i's covariance as published: its calibrated marginal (KeyPose::
-  // calibrated_covariance; the loop closer's check uses KeyPose::covariance) times marginal_scale, with the frame's heading (frame_heading_sigma_rad,
-  // or the boresight estimate's standard deviation while it is applied) and the key pose's own
-  // error (key_pose_sigma_xy_m); in the published frame. Zero for the first key pose.
+  // calibrated_covariance; the loop closer's check uses KeyPose::covariance) times marginal_scale,
+  // with the frame's heading (frame_heading_sigma_rad, or the boresight estimate's standard
+  // deviation while it is applied) and the key pose's own error (key_pose_sigma_xy_m); in the
+  // published frame. Zero for the first key pose.
   Eigen::Matrix3d published_covariance(int i) const;
   const Boresight& boresight() const { return boresight_; }
   const StartFrame& start_frame() const { return start_frame_; }
@@ -342,8 +349,8 @@ class Backend {
     // The odometry's step where it replaced the frontend's, its covariance widened by the two
     // steps' disagreement (key_link.cpp says why).
     std::optional<OdometryStep> odometry;
-    bool netted = false;  // ... the frontend's net motion over a spike
-    std::optional<Edge> link;              // the link edge: matched, or the fallback
+    bool netted = false;       // ... the frontend's net motion over a spike
+    std::optional<Edge> link;  // the link edge: matched, or the fallback
   };
   // The link of the new key pose `index` (its points in the base frame, its prepared pose
   // `now`): matched against the last link_chain_length key scans, the frontend's step checked

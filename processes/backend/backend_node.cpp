@@ -162,7 +162,7 @@ void BackendNode::publish_edges(std::size_t first, std::size_t last, int32_t opt
       // marginal_frontend_scale on the frontend's).
       const BackendConfig& c = backend_.config();
       const double scale =
-          c.marginal_scale * (e.kind == EdgeKind::kFrontend ? c.marginal_frontend_scale : 1.0);
+          c.marginal_scale * (frontend_chain(e.kind) ? c.marginal_frontend_scale : 1.0);
       copy_matrix(e.information / scale, m.information);
       msg.edges.push_back(m);
     }
