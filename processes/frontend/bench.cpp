@@ -1,13 +1,17 @@
 // traverse-frontend-bench: per-scan processing time of the frontend on one core, on the 8,536-point
-// sweeps of a 47.7 Hz scanner: read from a simulator log (--log: SCAN_HORIZONTAL and IMU), or made
+// sweeps of a 47.7 Hz scanner: read from a log (--log: SCAN_HORIZONTAL, IMU, ODOMETRY), or made
 // here (a cart at 0.5 m/s down a synthetic office corridor with 200 Hz IMU). Prints median and
-// p99 [ms], the real-time factor, and a JSON line last.
+// p99 [ms], the real-time factor, and a JSON line last. --trace FILE writes one CSV row per scan of
+// a log: what the frontend did with it (status, the prediction and the result, the fit, the search,
+// the held directions, the published sigmas) and, where the log has ground truth, the result's
+// error against it (the map frame tied to the truth at the first pose).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <deque>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -22,6 +26,7 @@
 #include "scan_message.hpp"
 #include "synthetic_scans.hpp"
 #include "traverse/imu_t.hpp"
+#include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
 #include "version.hpp"
@@ -38,6 +43,44 @@ double cpu_ms() {
   return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
 }
 
+// One scan's result, and the truth at its time in the estimate's map frame where the log has it.
+struct Trace {
+  int64_t utime = 0;
+  fe::FrontendResult result;
+  std::optional<traverse::Pose2> T_map_base_true;
+};
+
+// The trace as CSV: units in the column names, angles in degrees, sigmas from the published
+// covariance.
+void write_trace(const std::string& path, const std::vector<Trace>& trace) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out << "utime_us,status,sparse,x_m,y_m,theta_deg,pred_x_m,pred_y_m,pred_theta_deg,"
+         "valid_points,matched_points,iterations,residual_rms,searched,degeneracy_ratio,"
+         "degenerate_directions,sigma_x_m,sigma_y_m,sigma_theta_deg,err_x_m,err_y_m,"
+         "err_theta_deg\n";
+  const double deg = 180.0 / M_PI;
+  for (const Trace& row : trace) {
+    const fe::FrontendResult& r = row.result;
+    const fe::FrontendDiagnostics d = r.diagnostics.value_or(fe::FrontendDiagnostics{});
+    out << row.utime << ',' << static_cast<int>(r.status) << ',' << r.sparse << ','
+        << r.T_map_base.x() << ',' << r.T_map_base.y() << ',' << r.T_map_base.theta() * deg << ','
+        << d.T_map_base_predicted.x() << ',' << d.T_map_base_predicted.y() << ','
+        << d.T_map_base_predicted.theta() * deg << ',' << d.valid_points << ',' << d.matched_points
+        << ',' << d.iterations << ',' << d.residual_rms << ',' << d.searched << ','
+        << d.degeneracy_ratio << ',' << d.degenerate_directions << ','
+        << std::sqrt(r.covariance(0, 0)) << ',' << std::sqrt(r.covariance(1, 1)) << ','
+        << std::sqrt(r.covariance(2, 2)) * deg;
+    if (row.T_map_base_true && r.has_pose()) {
+      const traverse::Pose2& t = *row.T_map_base_true;
+      out << ',' << r.T_map_base.x() - t.x() << ',' << r.T_map_base.y() - t.y() << ','
+          << traverse::wrap_angle(r.T_map_base.theta() - t.theta()) * deg << '\n';
+    } else {
+      out << ",,,\n";
+    }
+  }
+}
+
 struct Timing {
   std::vector<double> ms;  // per scan
   int points = 0;          // per scan (last)
@@ -46,9 +89,9 @@ struct Timing {
   double error_m = -1.0;  // final position error, synthetic run only
 };
 
-// Every SCAN_HORIZONTAL of an LCM log through the frontend, IMU samples fed in time order; a scan
-// is processed once the IMU has passed its last point (as the node does).
-Timing run_log(const std::string& path, fe::Frontend& frontend) {
+// Every SCAN_HORIZONTAL of an LCM log through the frontend, with its IMU and ODOMETRY samples in
+// the log's order; POSE_GROUND_TRUTH, where the log has it, scores the result.
+Timing run_log(const std::string& path, fe::Frontend& frontend, std::vector<Trace>* trace) {
   Timing timing;
   traverse::LogReader reader(path);
   std::deque<fe::Scan> pending;
@@ -57,22 +100,44 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
   std::vector<std::pair<int64_t, traverse::Pose2>> estimates, truth;
   auto process = [&](const fe::Scan& scan) {
     const double t0 = cpu_ms();
-    const fe::FrontendResult r = frontend.process(scan);
+    fe::FrontendResult r = frontend.process(scan);
     timing.ms.push_back(cpu_ms() - t0);
     timing.points = static_cast<int>(scan.ranges.size());
     if (r.diagnostics) timing.matched_points = r.diagnostics->matched_points;
     if (r.has_pose()) estimates.emplace_back(r.utime, r.T_map_base);
+    if (trace) trace->push_back({r.utime, std::move(r), std::nullopt});
+  };
+  // A scan is processed once every motion stream the log has (IMU, wheel odometry) has passed its
+  // last point, as the node does.
+  std::optional<int64_t> last_imu, last_odometry;
+  auto flush = [&] {
+    const auto covered = [](const std::optional<int64_t>& last, int64_t utime) {
+      return !last || *last >= utime;
+    };
+    while (!pending.empty() && covered(last_imu, pending.front().utime_last) &&
+           covered(last_odometry, pending.front().utime_last)) {
+      process(pending.front());
+      pending.pop_front();
+    }
   };
   while (auto ev = reader.next()) {
     if (ev->channel == traverse::channels::kImu) {
       traverse::imu_t m;
       if (m.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
-      frontend.add_imu(m.utime, Eigen::Vector3d(m.angular_velocity[0], m.angular_velocity[1],
-                                                m.angular_velocity[2]));
-      while (!pending.empty() && pending.front().utime_last <= m.utime) {
-        process(pending.front());
-        pending.pop_front();
+      if (frontend.add_imu(m.utime, Eigen::Vector3d(m.angular_velocity[0], m.angular_velocity[1],
+                                                    m.angular_velocity[2]))) {
+        last_imu = m.utime;
       }
+      flush();
+    } else if (ev->channel == traverse::channels::kOdometry) {
+      traverse::odometry_t m;
+      if (m.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
+      fe::OdometrySample o;
+      o.utime = m.utime;
+      o.T_odom_base = traverse::Pose2(m.x, m.y, m.theta);
+      for (int i = 0; i < 9; ++i) o.pose_covariance(i / 3, i % 3) = m.pose_covariance[i];
+      if (frontend.add_odometry(o)) last_odometry = m.utime;
+      flush();
     } else if (ev->channel == traverse::channels::kPoseGroundTruth) {
       traverse::pose2d_t m;
       if (m.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
@@ -83,6 +148,7 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
       if (scans++ == 0) first_utime = m.utime_first;
       last_utime = m.utime_first;
       pending.push_back(traverse::to_planar_scan(m));
+      flush();
     }
   }
   for (const auto& scan : pending) process(scan);
@@ -108,6 +174,11 @@ Timing run_log(const std::string& path, fe::Frontend& frontend) {
     ++n;
   }
   if (n > 0) timing.error_m = std::sqrt(sum / n);
+  if (trace && T_world_map) {
+    for (Trace& row : *trace) {
+      if (auto T = truth_at(row.utime)) row.T_map_base_true = T_world_map->inverse() * *T;
+    }
+  }
   if (scans > 1)
     timing.rate_hz = (scans - 1) / (1e-6 * static_cast<double>(last_utime - first_utime));
   return timing;
@@ -155,12 +226,15 @@ Timing run_synthetic(int scans, fe::Frontend& frontend) {
 int main(int argc, char** argv) {
   CLI::App app("Frontend per-scan processing time on 8,536-point sweeps",
                "traverse-frontend-bench");
-  std::string log_path, config_path;
+  std::string log_path, config_path, trace_path;
   int scans = 1000;
   app.add_option("--log", log_path,
                  "LCM log with SCAN_HORIZONTAL and IMU (e.g. from traverse-sim)");
   app.add_option("--scans", scans, "synthetic sweeps when no --log")->capture_default_str();
   app.add_option("--config", config_path, "frontend config (YAML); defaults otherwise");
+  app.add_option("--trace", trace_path,
+                 "with --log: write one CSV row per scan (status, prediction, result, fit, "
+                 "search, held directions, sigmas, error against the log's ground truth)");
   traverse::add_version_flag(app);
   CLI11_PARSE(app, argc, argv);
   fe::FrontendConfig config;
@@ -174,7 +248,14 @@ int main(int argc, char** argv) {
   const std::unique_ptr<fe::Frontend> frontend = fe::make_frontend(config);
   Timing t;
   try {
-    t = log_path.empty() ? run_synthetic(scans, *frontend) : run_log(log_path, *frontend);
+    if (!trace_path.empty() && log_path.empty()) {
+      std::fprintf(stderr, "traverse-frontend-bench: --trace needs --log\n");
+      return 2;
+    }
+    std::vector<Trace> trace;
+    t = log_path.empty() ? run_synthetic(scans, *frontend)
+                         : run_log(log_path, *frontend, trace_path.empty() ? nullptr : &trace);
+    if (!trace_path.empty()) write_trace(trace_path, trace);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "traverse-frontend-bench: %s\n", e.what());
     return 1;

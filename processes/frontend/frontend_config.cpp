@@ -38,6 +38,9 @@ std::optional<std::string> validate(const MatcherConfig& c) {
   check.positive("prior_sigma_xy_m", c.prior_sigma_xy_m);
   check.positive("prior_sigma_theta_rad", c.prior_sigma_theta_rad);
   check.positive("min_residual_sigma", c.min_residual_sigma);
+  check.not_negative("coarse_check_m", c.coarse_check_m);
+  check.in_range("coarse_check_gain", c.coarse_check_gain, 0.0, 1.0);
+  check.not_negative("coarse_check_max_gap_us", c.coarse_check_max_gap_us);
   check.not_negative("search_trigger_residual", c.search_trigger_residual);
   check.positive("search_linear_window_m", c.search_linear_window_m);
   check.require(c.search_angular_window_rad > 0.0 && c.search_angular_window_rad <= M_PI,

@@ -57,6 +57,24 @@ struct MatcherConfig {
   double prior_sigma_xy_m = 0.5;
   double prior_sigma_theta_rad = 0.2;
   double min_residual_sigma = 0.02;  // floor of the map-value noise used to scale covariances
+  // The coarse levels can hand the finer ones a neighbouring basin: along a corridor, whose
+  // coarsest grid (4 x resolution_m) blurs the few features along the axis, a scan is carried a
+  // coarse cell along it and the fine levels settle there with a worse fit, and the next scan
+  // comes back (docs/frontends.md, "A coarse cell along the corridor"). On a driver's stream
+  // (each scan with its sweep's duration) whose scans come at most coarse_check_max_gap_us apart
+  // (this one, and the median of the last five intervals: the prediction then good to
+  // millimetres), a result farther than coarse_check_m [m] from the prediction is matched again
+  // from the prediction on the finest level alone, and that match is kept if its fit on the
+  // finest grid (RMS of 1 - M) is better by at least the share coarse_check_gain. Not on a log
+  // with one stamp per scan (CARMEN): at a few scans a second predictions are off by
+  // centimetres, and a logger's stamps may be its arrival times (intel's come in bursts 1 ms
+  // apart); there the check only perturbs. 0 m: off.
+  double coarse_check_m = 0.05;
+  double coarse_check_gain = 0.0;
+  int64_t coarse_check_max_gap_us = 50000;
+  // Also where the scan leaves a direction open (degeneracy_min_ratio), whose fit is flat along
+  // it and which the prediction holds.
+  bool coarse_check_open_directions = false;
   // Match each point only across its own surface (hector/surface_normals.hpp): the map's
   // gradient along a wall (where the map's wall ends, a far wall's dotted cells) pulls a
   // corridor's scan along the axis that nothing else holds. Applied only to scans predicted with
@@ -193,6 +211,10 @@ struct MatcherConfig {
     v("prior_sigma_xy_m", prior_sigma_xy_m);
     v("prior_sigma_theta_rad", prior_sigma_theta_rad);
     v("min_residual_sigma", min_residual_sigma);
+    v("coarse_check_m", coarse_check_m);
+    v("coarse_check_gain", coarse_check_gain);
+    v("coarse_check_max_gap_us", coarse_check_max_gap_us);
+    v("coarse_check_open_directions", coarse_check_open_directions);
     v("normal_projection", normal_projection);
     v("degeneracy_min_ratio", degeneracy_min_ratio);
     v("moved_max_probability", moved_max_probability);

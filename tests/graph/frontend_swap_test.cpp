@@ -11,12 +11,6 @@
 namespace traverse::graph_test {
 namespace {
 
-double number(const std::string& json, const std::string& key) {
-  const auto at = json.find("\"" + key + "\": ");
-  EXPECT_NE(at, std::string::npos) << key << " in " << json;
-  return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
-}
-
 // The ICP frontend is the better of the two on this stretch (0.66 against 0.94 mm position
 // RMSE): swapped from it to Hector, the swapped run stays within 20 % of it (1.16). Of the twelve
 // runs measured (seeds 1 to 3, both directions, ideal and realistic profiles) this one is the
@@ -29,11 +23,12 @@ TEST(FrontendSwap, IcpToHectorAtTheMidpointOfASimulatedRoute) {
                      600);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string json = r.output.substr(r.output.rfind("{\"route\""));
-  const double hector = number(json, "hector_alone_rmse_m"), icp = number(json, "icp_alone_rmse_m");
-  const double swapped = number(json, "swapped_rmse_m");
+  const double hector = json_number(json, "hector_alone_rmse_m");
+  const double icp = json_number(json, "icp_alone_rmse_m");
+  const double swapped = json_number(json, "swapped_rmse_m");
   std::printf("swap: hector %.5f m, icp %.5f m, swapped %.5f m\n", hector, icp, swapped);
   EXPECT_LE(swapped, 1.2 * std::min(hector, icp)) << json;
-  EXPECT_LT(number(json, "swap_step_error_max_m"), 0.05) << json;
+  EXPECT_LT(json_number(json, "swap_step_error_max_m"), 0.05) << json;
 }
 
 }  // namespace

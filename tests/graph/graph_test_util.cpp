@@ -35,6 +35,12 @@ CommandResult run(const std::string& command, int timeout_s) {
 
 std::string bin_dir() { return TRAVERSE_BIN_DIR; }
 
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  EXPECT_NE(at, std::string::npos) << key << " in " << json;
+  return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
+}
+
 std::string read_text(const std::filesystem::path& path) {
   std::stringstream s;
   s << std::ifstream(path).rdbuf();

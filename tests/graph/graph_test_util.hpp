@@ -27,6 +27,9 @@ std::filesystem::path temp_dir(const std::string& name);  // fresh, under the sy
 
 // The whole text of a file ("" when it cannot be read).
 std::string read_text(const std::filesystem::path& path);
+// The number after "KEY": in a script's JSON line (Python's spacing); fails the test and returns
+// -1 when the key is missing.
+double json_number(const std::string& json, const std::string& key);
 // The pid a launcher's processes.json gives `name`, 0 when it is not there (yet) or not running.
 int running_pid(const std::filesystem::path& processes_json, const std::string& name);
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 
+#include "degeneracy.hpp"
 #include "grid_search.hpp"
 #include "step_prior.hpp"
 #include "surface_normals.hpp"
@@ -167,6 +168,27 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
   const auto normals = matching_normals(points_base, config);
   MatchResult result = refine(maps, points_base, normals.get(), T_map_base_predicted,
                               T_map_base_predicted, config, first_level, last_level);
+  // A coarse level's neighbouring basin (MatcherConfig::coarse_check_m): the finest level alone
+  // from the prediction, the better fit on the finest grid kept. Where the scan leaves a direction
+  // open (degeneracy.hpp) only with coarse_check_open_directions: the fit is flat along it, and
+  // the prediction holds it.
+  if (config.coarse_check_m > 0.0 && first_level > last_level) {
+    const Pose2 d = between(T_map_base_predicted, result.T_map_base);
+    if (d.translation().norm() > config.coarse_check_m &&
+        (config.coarse_check_open_directions || config.degeneracy_min_ratio <= 0.0 ||
+         analyse_degeneracy(result.information, points_rms_range_m(points_base),
+                            config.degeneracy_min_ratio)
+                 .directions == 0)) {
+      MatchResult fine = refine(maps, points_base, normals.get(), T_map_base_predicted,
+                                T_map_base_predicted, config, last_level, last_level);
+      fine.iterations += result.iterations;
+      if (fine.residual_rms < (1.0 - config.coarse_check_gain) * result.residual_rms) {
+        result = fine;
+      } else {
+        result.iterations = fine.iterations;
+      }
+    }
+  }
   if (result.residual_rms <= config.search_trigger_residual) return result;
   std::vector<Pose2> centres{T_map_base_predicted};
   centres.insert(centres.end(), other_centres.begin(), other_centres.end());
