@@ -23,10 +23,10 @@
 #include "frontend.hpp"
 #include "json.hpp"
 #include "lcm_log.hpp"
+#include "odometry_message.hpp"
 #include "scan_message.hpp"
 #include "synthetic_scans.hpp"
 #include "traverse/imu_t.hpp"
-#include "traverse/odometry_t.hpp"
 #include "traverse/planar_scan_t.hpp"
 #include "traverse/pose2d_t.hpp"
 #include "version.hpp"
@@ -132,11 +132,7 @@ Timing run_log(const std::string& path, fe::Frontend& frontend, std::vector<Trac
     } else if (ev->channel == traverse::channels::kOdometry) {
       traverse::odometry_t m;
       if (m.decode(ev->data.data(), 0, static_cast<int>(ev->data.size())) < 0) continue;
-      fe::OdometrySample o;
-      o.utime = m.utime;
-      o.T_odom_base = traverse::Pose2(m.x, m.y, m.theta);
-      for (int i = 0; i < 9; ++i) o.pose_covariance(i / 3, i % 3) = m.pose_covariance[i];
-      if (frontend.add_odometry(o)) last_odometry = m.utime;
+      if (frontend.add_odometry(fe::to_odometry_sample(m))) last_odometry = m.utime;
       flush();
     } else if (ev->channel == traverse::channels::kPoseGroundTruth) {
       traverse::pose2d_t m;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "odometry_message.hpp"
 #include "scan_message.hpp"
 #include "state_file.hpp"
 #include "traverse/pose2d_t.hpp"
@@ -69,10 +70,7 @@ void FrontendNode::on_imu(const imu_t& msg) {
 }
 
 void FrontendNode::on_odometry(const odometry_t& msg) {
-  OdometrySample o;
-  o.utime = msg.utime;
-  o.T_odom_base = Pose2(msg.x, msg.y, msg.theta);
-  for (int i = 0; i < 9; ++i) o.pose_covariance(i / 3, i % 3) = msg.pose_covariance[i];
+  const OdometrySample o = to_odometry_sample(msg);
   if (frontend_->add_odometry(o)) {
     last_odometry_utime_ = msg.utime;
     handover_.add_odometry(o);

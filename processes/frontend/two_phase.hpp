@@ -24,10 +24,6 @@ struct Measurement {
   // The stream's recent scans came further apart than a scanner's period (its median interval
   // above MatcherConfig::wide_search_gap_us): a log subsampled by travel.
   bool subsampled_by_travel = false;
-  // A scanner's fast stream with its beams' times: the scan carries its sweep's duration (a
-  // driver's, not a log's one stamp per scan) and came, as the stream's recent scans did, at most
-  // MatcherConfig::coarse_check_max_gap_us after the one before.
-  bool fast_timed_stream = false;
   // Wheel odometry's step from the pose before to this scan, where the prediction took it.
   std::optional<Pose2> odometry_step;
   // A step the data show is long: its length [m], where a search wider than the wide search's

@@ -20,7 +20,7 @@ TEST(CoarseFlip, NoScanIsCarriedACoarseCellAlongTheCorridor) {
                          "frontend --offline --tag coarse-flip-test",
                      600);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string json = r.output.substr(r.output.rfind("{\"route\""));
+  const std::string json = route_json(r.output);
   const double jump = json_number(json, "max_jump_m"), rpe = json_number(json, "rpe_1m_m");
   std::printf("lab-loop seed 2, 40 s, frontend: largest jump %.3f m, RPE over 1 m %.3f m\n", jump,
               rpe);

@@ -22,7 +22,7 @@ TEST(FrontendSwap, IcpToHectorAtTheMidpointOfASimulatedRoute) {
                          "--duration 40 --from icp --to hector",
                      600);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string json = r.output.substr(r.output.rfind("{\"route\""));
+  const std::string json = route_json(r.output);
   const double hector = json_number(json, "hector_alone_rmse_m");
   const double icp = json_number(json, "icp_alone_rmse_m");
   const double swapped = json_number(json, "swapped_rmse_m");

@@ -41,6 +41,12 @@ double json_number(const std::string& json, const std::string& key) {
   return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
 }
 
+std::string route_json(const std::string& output) {
+  const auto at = output.rfind("{\"route\"");
+  EXPECT_NE(at, std::string::npos) << "no JSON line in " << output;
+  return at == std::string::npos ? std::string() : output.substr(at);
+}
+
 std::string read_text(const std::filesystem::path& path) {
   std::stringstream s;
   s << std::ifstream(path).rdbuf();

@@ -30,6 +30,9 @@ std::string read_text(const std::filesystem::path& path);
 // The number after "KEY": in a script's JSON line (Python's spacing); fails the test and returns
 // -1 when the key is missing.
 double json_number(const std::string& json, const std::string& key);
+// The JSON object an evaluation script prints last (its output from the last "{\"route\""); empty,
+// failing the test, when there is none.
+std::string route_json(const std::string& output);
 // The pid a launcher's processes.json gives `name`, 0 when it is not there (yet) or not running.
 int running_pid(const std::filesystem::path& processes_json, const std::string& name);
 

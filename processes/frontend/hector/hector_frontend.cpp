@@ -74,12 +74,6 @@ Measurement HectorFrontend::measure(const Scan& scan) {
   r.sparse =
       initialised && (scan.utime_last - motion_.last_utime() > config_.matcher.wide_search_gap_us ||
                       m.subsampled_by_travel);
-  // A driver's stream stamps each beam; a log's one stamp per scan may be the logger's arrival
-  // time (intel: a quarter of its intervals under 1.2 ms, its median 97 ms).
-  const int64_t fast = config_.matcher.coarse_check_max_gap_us;
-  m.fast_timed_stream = initialised && scan.utime_last > scan.utime_first && motion_.pace_known() &&
-                        !motion_.subsampled_by_travel(fast) &&
-                        scan.utime_last - motion_.last_utime() <= fast;
 
   if (d.valid_points < config_.matcher.min_valid_points) {
     ++counters_.scans_predicted;
@@ -115,7 +109,15 @@ Measurement HectorFrontend::measure(const Scan& scan) {
     deskew();
     if (!r.sparse) drop_moved(points.points_base, with.T_map_base);
     m.points_matched = subsample(points.points_base, config_.matcher.min_point_spacing_m);
-    Attempt attempt = match_from(m, with);
+    // The coarse-cell check (MatcherConfig::coarse_check_m) on a driver's fast stream only: the
+    // scan carries its sweep's duration (a log's one stamp per scan may be the logger's arrival
+    // time: intel, a quarter of its intervals under 1.2 ms, its median 97 ms), and it came, as
+    // the stream's recent scans did, at most coarse_check_max_gap_us after the one before.
+    const int64_t fast = config_.matcher.coarse_check_max_gap_us;
+    const bool coarse_check = scan.utime_last > scan.utime_first && motion_.pace_known() &&
+                              !motion_.subsampled_by_travel(fast) &&
+                              scan.utime_last - motion_.last_utime() <= fast;
+    Attempt attempt = match_from(m, with, coarse_check);
     // Odometry's step is checked against the scan (a scanner's stream): matched also from the
     // prediction without it, the result that fits clearly better stands (a wheel slipped, the
     // odometry's stamps are off), if the scan tells the two apart (not along a corridor's axis,
@@ -124,7 +126,7 @@ Measurement HectorFrontend::measure(const Scan& scan) {
       const MotionModel::Prediction without =
           motion_.predict(scan.utime_last, use_imu, r.sparse, false);
       if (differ(with.T_map_base, without.T_map_base)) {
-        Attempt other = match_from(m, without);
+        Attempt other = match_from(m, without, coarse_check);
         if (better(other, attempt, config_.motion_prior.odometry_check_margin) &&
             apart(other, attempt, determined(attempt.match, m.points_matched),
                   config_.motion_prior.odometry_check_sigmas)) {
@@ -173,7 +175,8 @@ Measurement HectorFrontend::measure(const Scan& scan) {
 }
 
 HectorFrontend::Attempt HectorFrontend::match_from(const Measurement& m,
-                                                   const MotionModel::Prediction& p) const {
+                                                   const MotionModel::Prediction& p,
+                                                   bool coarse_check) const {
   const Pose2& T_pred = p.T_map_base;
   const Pose2& T_last = motion_.last_pose();
   const bool sparse = m.result.sparse;
@@ -185,8 +188,8 @@ HectorFrontend::Attempt HectorFrontend::match_from(const Measurement& m,
   }
   MatcherConfig matcher = matcher_for(p);
   // A coarse cell's flip shows as a result far from the prediction only where the prediction is
-  // good to well under that distance (MatcherConfig::coarse_check_m).
-  if (!m.fast_timed_stream) matcher.coarse_check_m = 0.0;
+  // good to well under that distance.
+  if (!coarse_check) matcher.coarse_check_m = 0.0;
   // The sub-cell map is read on a scanner's stream, a pause in it included (a scan matched on the
   // plain map there is placed with the grid's pull and lays the map down so: intel, relations,
   // frontend alone 0.016 m -> 0.31 m); a log subsampled by travel (or whose first scans come so

@@ -103,7 +103,10 @@ class HectorFrontend final : public TwoPhaseFrontend {
     MatchResult match;
     bool unverified = false;
   };
-  Attempt match_from(const Measurement& m, const MotionModel::Prediction& prediction) const;
+  // coarse_check: the scan may take the matcher's coarse-cell check
+  // (MatcherConfig::coarse_check_m).
+  Attempt match_from(const Measurement& m, const MotionModel::Prediction& prediction,
+                     bool coarse_check) const;
   // Drops the points the map has seen through at the predicted pose (moved_points.hpp,
   // MatcherConfig::moved_max_probability), unless that is most of them.
   void drop_moved(std::vector<Eigen::Vector2d>& points_base, const Pose2& T_map_base_predicted);

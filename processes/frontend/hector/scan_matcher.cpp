@@ -179,14 +179,11 @@ MatchResult match_scan(const MapPyramid& maps, const std::vector<Eigen::Vector2d
          analyse_degeneracy(result.information, points_rms_range_m(points_base),
                             config.degeneracy_min_ratio)
                  .directions == 0)) {
-      MatchResult fine = refine(maps, points_base, normals.get(), T_map_base_predicted,
-                                T_map_base_predicted, config, last_level, last_level);
-      fine.iterations += result.iterations;
-      if (fine.residual_rms < (1.0 - config.coarse_check_gain) * result.residual_rms) {
-        result = fine;
-      } else {
-        result.iterations = fine.iterations;
-      }
+      const MatchResult fine = refine(maps, points_base, normals.get(), T_map_base_predicted,
+                                      T_map_base_predicted, config, last_level, last_level);
+      const int iterations = result.iterations + fine.iterations;
+      if (fine.residual_rms < (1.0 - config.coarse_check_gain) * result.residual_rms) result = fine;
+      result.iterations = iterations;
     }
   }
   if (result.residual_rms <= config.search_trigger_residual) return result;
