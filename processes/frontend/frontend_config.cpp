@@ -101,6 +101,7 @@ std::optional<std::string> validate(const MotionPriorConfig& c) {
   check.in_range("search_min_angular_rad", c.search_min_angular_rad, 0.0, M_PI);
   check.in_range("prediction_sigma_mps", c.prediction_sigma_mps, 0.0, 100.0);
   check.in_range("prediction_sigma_radps", c.prediction_sigma_radps, 0.0, 100.0);
+  check.in_range("max_acceleration_mps2", c.max_acceleration_mps2, 0.0, 1000.0);
   return check.problem();
 }
 
@@ -134,6 +135,11 @@ std::optional<std::string> validate(const FrontendConfig& c) {
                 "matcher.wide_search_linear_window_m", "must be at most 200 cells of map level 1");
   check.require(c.matcher.sparse_lag_window_m <= c.matcher.wide_search_linear_window_m,
                 "matcher.sparse_lag_window_m", "must be at most wide_search_linear_window_m");
+  check.require(
+      !c.matcher.degeneracy_hold_without_odometry || c.motion_prior.max_acceleration_mps2 > 0.0,
+      "matcher.degeneracy_hold_without_odometry",
+      "needs motion_prior.max_acceleration_mps2 > 0 (an unbounded velocity is no "
+      "prediction to hold)");
   return check.problem();
 }
 

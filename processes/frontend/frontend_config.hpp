@@ -93,6 +93,14 @@ struct MatcherConfig {
   // weighed as the arc it moves the points through) below this share of the largest are held at
   // the odometry prediction, and take the prediction's covariance. 0 never holds any.
   double degeneracy_min_ratio = 0.0;
+  // Hold them also where no odometry predicts the scan, at the prediction of the last poses'
+  // velocity, which must then be bounded (motion_prior.max_acceleration_mps2 > 0). Off by
+  // default: it holds a robot that drives from rooms into a corridor (the realistic simulator's
+  // office-rooms, IMU alone: lost runs of 1.4-6.2 m within 0.47 m), but loses a cart in a 56 m bare
+  // corridor that the match's faint grip along the axis holds (corridor-return seed 1: 0.41 ->
+  // 17.5 m), and the map made at held poses along a corridor no longer agrees with the matches
+  // once the hold lets go (docs/frontends.md, "Open directions without odometry").
+  bool degeneracy_hold_without_odometry = false;
   // On a scanner's stream, points where the map (level 1) holds only cells below this occupancy
   // probability all around, at the predicted pose, are left out of the match and the map
   // (hector/moved_points.hpp: people walking through, mixed pixels). 0 keeps every point. 0.25
@@ -217,6 +225,7 @@ struct MatcherConfig {
     v("coarse_check_open_directions", coarse_check_open_directions);
     v("normal_projection", normal_projection);
     v("degeneracy_min_ratio", degeneracy_min_ratio);
+    v("degeneracy_hold_without_odometry", degeneracy_hold_without_odometry);
     v("moved_max_probability", moved_max_probability);
     v("search_trigger_residual", search_trigger_residual);
     v("search_linear_window_m", search_linear_window_m);
@@ -318,6 +327,15 @@ struct MotionPriorConfig {
   // (MatcherConfig::degeneracy_min_ratio) adds to its variance per scan.
   double prediction_sigma_mps = 0.05;
   double prediction_sigma_radps = 0.02;
+  // [m/s^2] The velocity of the last poses (the prediction without odometry) changes by at most
+  // this times the interval per pose: a platform that is pushed, driven or carried does not gain
+  // a metre a second between two scans, but a match that lands 5 cm off along a direction the
+  // scan barely determines (a corridor's axis) is 4 m/s over a 13 ms interval, and the next
+  // predictions would carry it on. 0: no limit. Off by default: at 2 m/s^2 it shrank the lost
+  // runs of the simulator's robots without wheels but not all, and made lab-loop seed 2 worse
+  // (docs/frontends.md, "Open directions without odometry"); with
+  // MatcherConfig::degeneracy_hold_without_odometry it is what the hold holds to.
+  double max_acceleration_mps2 = 0.0;
 
   template <class V>
   void visit(V& v) {
@@ -337,6 +355,7 @@ struct MotionPriorConfig {
     v("search_min_angular_rad", search_min_angular_rad);
     v("prediction_sigma_mps", prediction_sigma_mps);
     v("prediction_sigma_radps", prediction_sigma_radps);
+    v("max_acceleration_mps2", max_acceleration_mps2);
   }
 };
 

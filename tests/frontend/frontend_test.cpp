@@ -247,6 +247,13 @@ TEST(Frontend, ShippedConfigLoadsAndIsUsable) {
   const auto lag_problem = validate(no_lag_window);
   ASSERT_NE(lag_problem, std::nullopt);
   EXPECT_NE(lag_problem->find("matcher.sparse_lag_window_m"), std::string::npos) << *lag_problem;
+  FrontendConfig unbounded_hold = config;
+  unbounded_hold.matcher.degeneracy_hold_without_odometry = true;
+  unbounded_hold.motion_prior.max_acceleration_mps2 = 0.0;
+  const auto hold_problem = validate(unbounded_hold);
+  ASSERT_NE(hold_problem, std::nullopt);
+  EXPECT_NE(hold_problem->find("matcher.degeneracy_hold_without_odometry"), std::string::npos)
+      << *hold_problem;
   config.map.levels = 0;
   EXPECT_NE(validate(config), std::nullopt);
 }

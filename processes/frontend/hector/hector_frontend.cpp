@@ -248,11 +248,13 @@ void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match
   if (config_.matcher.degeneracy_min_ratio <= 0.0 || dg.directions == 0) return;
   ++counters_.scans_degenerate;
   r.diagnostics->degenerate_directions = dg.directions;
-  // Only odometry measures the motion along such a direction; the velocity of the last poses
-  // would carry on whatever speed the corridor was entered with, and the match's faint hold
-  // (an end wall 40 m ahead, a door recess) does better than that. Either way the covariance
+  // Odometry measures the motion along such a direction. Without it the velocity of the last
+  // poses carries on the speed the corridor was entered with, and the match's faint grip (an end
+  // wall 40 m ahead, a door recess) does better than that in a long bare corridor; held there
+  // only on request (MatcherConfig::degeneracy_hold_without_odometry). Either way the covariance
   // says how little the scan fixed there.
-  if (prediction.odometry) r.T_map_base = remap(dg, prediction.T_map_base, r.T_map_base);
+  if (prediction.odometry || hold_without_odometry())
+    r.T_map_base = remap(dg, prediction.T_map_base, r.T_map_base);
   r.covariance = remapped_covariance(dg, prediction.covariance);
 }
 

@@ -39,7 +39,12 @@ void MotionModel::add_pose(int64_t utime, const Pose2& T_map_base,
     const double dt = 1e-6 * static_cast<double>(interval_us);
     const Eigen::Vector3d v = step / dt;
     const double alpha = std::min(1.0, dt / kVelocitySmoothingS);
-    s.velocity = alpha * v + (1.0 - alpha) * s.velocity;
+    Eigen::Vector3d velocity = alpha * v + (1.0 - alpha) * s.velocity;
+    const double max_change = prior_.config().max_acceleration_mps2 * dt;  // [m/s]
+    const Eigen::Vector2d change = velocity.head<2>() - s.velocity.head<2>();
+    if (max_change > 0.0 && change.norm() > max_change)
+      velocity.head<2>() = s.velocity.head<2>() + change * (max_change / change.norm());
+    s.velocity = velocity;
     s.last_interval_us = interval_us;
     if (sparse) {
       constexpr double a = kSparseStepSmoothing;

@@ -11,7 +11,9 @@
 //   - Translation otherwise: the velocity of the last poses over the elapsed time, over at most
 //     twice the last interval (after a pause it would predict an arbitrarily long step). The
 //     velocity is differenced from consecutive poses and averaged exponentially over about 0.1 s
-//     (poses a few milliseconds apart are noisy to difference).
+//     (poses a few milliseconds apart are noisy to difference), and changes by at most
+//     MotionPriorConfig::max_acceleration_mps2 times the interval (one match off along a
+//     corridor's axis is no change of speed).
 //   - Sparse scans (far apart in time, see MatcherConfig::wide_search_gap_us) of a log
 //     subsampled by travel (the CARMEN sets) without IMU or odometry: their times say little
 //     about the motion, so the prediction is the average of the last sparse steps. Such a log
