@@ -15,12 +15,8 @@ namespace traverse::graph_test {
 namespace {
 
 TEST(CoarseFlip, NoScanIsCarriedACoarseCellAlongTheCorridor) {
-  const auto r = run("TRAVERSE_BIN_DIR=" + bin_dir() +
-                         " scripts/eval-route.sh lab-loop --seed 2 --duration 40 --stages "
-                         "frontend --offline --tag coarse-flip-test",
-                     600);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string json = route_json(r.output);
+  const std::string json = eval_route(
+      "lab-loop --seed 2 --duration 40 --stages frontend --offline --tag coarse-flip-test");
   const double jump = json_number(json, "max_jump_m"), rpe = json_number(json, "rpe_1m_m");
   std::printf("lab-loop seed 2, 40 s, frontend: largest jump %.3f m, RPE over 1 m %.3f m\n", jump,
               rpe);

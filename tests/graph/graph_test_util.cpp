@@ -47,6 +47,12 @@ std::string route_json(const std::string& output) {
   return at == std::string::npos ? std::string() : output.substr(at);
 }
 
+std::string eval_route(const std::string& args) {
+  const auto r = run("TRAVERSE_BIN_DIR=" + bin_dir() + " scripts/eval-route.sh " + args, 600);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return route_json(r.output);
+}
+
 std::string read_text(const std::filesystem::path& path) {
   std::stringstream s;
   s << std::ifstream(path).rdbuf();

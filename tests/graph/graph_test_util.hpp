@@ -33,6 +33,9 @@ double json_number(const std::string& json, const std::string& key);
 // The JSON object an evaluation script prints last (its output from the last "{\"route\""); empty,
 // failing the test, when there is none.
 std::string route_json(const std::string& output);
+// scripts/eval-route.sh ARGS with this build's programs (10 min at most): its JSON line, failing
+// the test when the script fails.
+std::string eval_route(const std::string& args);
 // The pid a launcher's processes.json gives `name`, 0 when it is not there (yet) or not running.
 int running_pid(const std::filesystem::path& processes_json, const std::string& name);
 

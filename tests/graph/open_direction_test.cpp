@@ -24,13 +24,8 @@ struct Figures {
 };
 
 Figures office_rooms_seed3(const std::string& tag, const std::string& sets) {
-  const auto r = run("TRAVERSE_BIN_DIR=" + bin_dir() +
-                         " scripts/eval-route.sh office-rooms --seed 3 --duration 90 --stages "
-                         "frontend --offline --tag " +
-                         tag + sets,
-                     600);
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  const std::string json = route_json(r.output);
+  const std::string json = eval_route(
+      "office-rooms --seed 3 --duration 90 --stages frontend --offline --tag " + tag + sets);
   const Figures f{json_number(json, "position_rmse_m"), json_number(json, "rpe_10m_m")};
   std::printf(
       "office-rooms seed 3, 90 s, frontend (%s): position RMSE %.3f m, RPE over 10 m %.3f m\n",

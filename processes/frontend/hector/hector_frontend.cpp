@@ -251,9 +251,10 @@ void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match
   // Odometry measures the motion along such a direction. Without it the velocity of the last
   // poses carries on the speed the corridor was entered with, and the match's faint grip (an end
   // wall 40 m ahead, a door recess) does better than that in a long bare corridor; held there
-  // only on request (MatcherConfig::degeneracy_hold_without_odometry). Either way the covariance
-  // says how little the scan fixed there.
-  if (prediction.odometry || hold_without_odometry())
+  // only on request (MatcherConfig::degeneracy_hold_without_odometry, which the config check lets
+  // through only with that velocity bounded). Either way the covariance says how little the scan
+  // fixed there.
+  if (prediction.odometry || config_.matcher.degeneracy_hold_without_odometry)
     r.T_map_base = remap(dg, prediction.T_map_base, r.T_map_base);
   r.covariance = remapped_covariance(dg, prediction.covariance);
 }

@@ -116,12 +116,6 @@ class HectorFrontend final : public TwoPhaseFrontend {
   void hold_degenerate(FrontendResult& r, const MatchResult& match,
                        const std::vector<Eigen::Vector2d>& points_matched,
                        const MotionModel::Prediction& prediction);
-  // Directions a scan leaves open are held at a prediction without odometry too
-  // (MatcherConfig::degeneracy_hold_without_odometry, the velocity bounded).
-  bool hold_without_odometry() const {
-    return config_.matcher.degeneracy_hold_without_odometry &&
-           config_.motion_prior.max_acceleration_mps2 > 0.0;
-  }
   // a and b lie more than a map cell or 0.01 rad apart (worth matching from both).
   bool differ(const Pose2& a, const Pose2& b) const;
   // a fits better than b: verified where b is not, else a residual lower by more than margin.
