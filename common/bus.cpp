@@ -32,6 +32,11 @@ Bus::Subscription* Bus::add_subscription(const std::string& channel, bool counte
   sub->counted = counted;
   sub->dispatch = std::move(dispatch);
   sub->lcm_subscription = lcm_.subscribe(channel, &Subscription::on_message, sub.get());
+  // LCM keeps at most 30 messages per subscription between its socket and this bus's reader by
+  // default and drops the rest uncounted: a burst of small messages (a log replayed fast, a
+  // frontend's IMU while the reader waits for a core) lost most of itself there. The bus's own
+  // queue, bounded by `input.max_queue_bytes` and counted, is the one limit.
+  sub->lcm_subscription->setQueueCapacity(kLcmQueueMessages);
   subscriptions_.push_back(std::move(sub));
   return subscriptions_.back().get();
 }

@@ -148,6 +148,10 @@ class Bus : public Publisher {
   void reject(const std::string& channel, const std::string& why);
   int64_t max_stamp_jump_us() const;
 
+  // Messages LCM may hold for one subscription before this bus's reader takes them (its default
+  // is 30); the reader only copies them into the counted queue, so this is seldom reached.
+  static constexpr int kLcmQueueMessages = 100000;
+
   std::string url_;
   InputConfig input_;
   std::vector<ArrayLimit> limits_;
