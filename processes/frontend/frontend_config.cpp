@@ -41,6 +41,8 @@ std::optional<std::string> validate(const MatcherConfig& c) {
   check.not_negative("coarse_check_m", c.coarse_check_m);
   check.in_range("coarse_check_gain", c.coarse_check_gain, 0.0, 1.0);
   check.not_negative("coarse_check_max_gap_us", c.coarse_check_max_gap_us);
+  check.not_negative("degeneracy_hold_after_s", c.degeneracy_hold_after_s);
+  check.not_negative("degeneracy_hold_max_s", c.degeneracy_hold_max_s);
   check.not_negative("search_trigger_residual", c.search_trigger_residual);
   check.positive("search_linear_window_m", c.search_linear_window_m);
   check.require(c.search_angular_window_rad > 0.0 && c.search_angular_window_rad <= M_PI,

@@ -101,6 +101,13 @@ struct MatcherConfig {
   // 17.5 m), and the map made at held poses along a corridor no longer agrees with the matches
   // once the hold lets go (docs/frontends.md, "Open directions without odometry").
   bool degeneracy_hold_without_odometry = false;
+  // That hold only where the velocity it holds to was measured: after the scans determined the
+  // whole pose for at least degeneracy_hold_after_s without a break (a cart that starts in a bare
+  // corridor has only the standstill it started from), and for at most degeneracy_hold_max_s
+  // after the last scan that did (0: no limit; the velocity drifts the longer it is held: a cart
+  // walking back along the bare corridor it came). 0 and 0 hold as above.
+  double degeneracy_hold_after_s = 0.0;
+  double degeneracy_hold_max_s = 0.0;
   // On a scanner's stream, points where the map (level 1) holds only cells below this occupancy
   // probability all around, at the predicted pose, are left out of the match and the map
   // (hector/moved_points.hpp: people walking through, mixed pixels). 0 keeps every point. 0.25
@@ -226,6 +233,8 @@ struct MatcherConfig {
     v("normal_projection", normal_projection);
     v("degeneracy_min_ratio", degeneracy_min_ratio);
     v("degeneracy_hold_without_odometry", degeneracy_hold_without_odometry);
+    v("degeneracy_hold_after_s", degeneracy_hold_after_s);
+    v("degeneracy_hold_max_s", degeneracy_hold_max_s);
     v("moved_max_probability", moved_max_probability);
     v("search_trigger_residual", search_trigger_residual);
     v("search_linear_window_m", search_linear_window_m);

@@ -245,6 +245,7 @@ void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match
                                      const MotionModel::Prediction& prediction) {
   const Degeneracy dg = degeneracy(match.information, points_matched);
   r.diagnostics->degeneracy_ratio = dg.ratio;
+  note_determined(r.utime, dg.directions == 0);
   if (config_.matcher.degeneracy_min_ratio <= 0.0 || dg.directions == 0) return;
   ++counters_.scans_degenerate;
   r.diagnostics->degenerate_directions = dg.directions;
@@ -254,9 +255,28 @@ void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match
   // only on request (MatcherConfig::degeneracy_hold_without_odometry, which the config check lets
   // through only with that velocity bounded). Either way the covariance says how little the scan
   // fixed there.
-  if (prediction.odometry || config_.matcher.degeneracy_hold_without_odometry)
+  if (prediction.odometry || hold_without_odometry(r.utime))
     r.T_map_base = remap(dg, prediction.T_map_base, r.T_map_base);
   r.covariance = remapped_covariance(dg, prediction.covariance);
+}
+
+void HectorFrontend::note_determined(int64_t utime, bool determined) {
+  if (!determined) {
+    determined_run_start_utime_.reset();
+    return;
+  }
+  if (!determined_run_start_utime_) determined_run_start_utime_ = utime;
+  const double run_s = 1e-6 * static_cast<double>(utime - *determined_run_start_utime_);
+  if (run_s >= config_.matcher.degeneracy_hold_after_s) measured_velocity_utime_ = utime;
+}
+
+bool HectorFrontend::hold_without_odometry(int64_t utime) const {
+  const MatcherConfig& c = config_.matcher;
+  if (!c.degeneracy_hold_without_odometry) return false;
+  if (c.degeneracy_hold_after_s <= 0.0 && c.degeneracy_hold_max_s <= 0.0) return true;
+  if (!measured_velocity_utime_) return false;
+  const double since_s = 1e-6 * static_cast<double>(utime - *measured_velocity_utime_);
+  return c.degeneracy_hold_max_s <= 0.0 || since_s <= c.degeneracy_hold_max_s;
 }
 
 bool HectorFrontend::differ(const Pose2& a, const Pose2& b) const {
