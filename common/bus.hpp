@@ -49,6 +49,11 @@ inline constexpr const char* kDefaultLcmUrl =
 
 class Bus : public Publisher {
  public:
+  // Messages LCM may hold for one subscription before this bus's reader takes them (its default
+  // is 30, and it drops the rest uncounted); the reader only copies them into the counted queue,
+  // so this is seldom reached. Every subscription on lcm() directly should set it too.
+  static constexpr int kLcmQueueMessages = 100000;
+
   explicit Bus(const std::string& url, const InputConfig& input = {});
   bool good() const { return lcm_.good(); }
   const std::string& url() const { return url_; }
@@ -147,10 +152,6 @@ class Bus : public Publisher {
   void delivered(const std::string& channel, int64_t utime);
   void reject(const std::string& channel, const std::string& why);
   int64_t max_stamp_jump_us() const;
-
-  // Messages LCM may hold for one subscription before this bus's reader takes them (its default
-  // is 30); the reader only copies them into the counted queue, so this is seldom reached.
-  static constexpr int kLcmQueueMessages = 100000;
 
   std::string url_;
   InputConfig input_;

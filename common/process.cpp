@@ -172,7 +172,9 @@ std::optional<int> Process::connect() {
       spdlog::error("traverse-{}: cannot write --record {}", name_, record_path_);
       return 1;
     }
-    bus_->lcm().subscribe(".*", &Recorder::on_message, recorder_.get());
+    bus_->lcm()
+        .subscribe(".*", &Recorder::on_message, recorder_.get())
+        ->setQueueCapacity(Bus::kLcmQueueMessages);
   }
   return std::nullopt;
 }

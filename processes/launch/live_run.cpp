@@ -11,6 +11,7 @@
 #include <set>
 #include <thread>
 
+#include "bus.hpp"
 #include "channels.hpp"
 #include "control.hpp"
 #include "launch_report.hpp"
@@ -84,7 +85,7 @@ std::set<std::string> wait_until_ready(const std::string& url, std::set<std::str
       }
     }
   } handler{&waiting};
-  lcm.subscribe("STATUS_.*", &Handler::on, &handler);
+  lcm.subscribe("STATUS_.*", &Handler::on, &handler)->setQueueCapacity(Bus::kLcmQueueMessages);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (!waiting.empty() && !stopping(policy) && std::chrono::steady_clock::now() < deadline) {
     lcm.handleTimeout(50);
