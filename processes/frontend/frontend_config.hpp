@@ -105,7 +105,8 @@ struct MatcherConfig {
   // whole pose for at least degeneracy_hold_after_s without a break (a cart that starts in a bare
   // corridor has only the standstill it started from), and for at most degeneracy_hold_max_s
   // after the last scan that did (0: no limit; the velocity drifts the longer it is held: a cart
-  // walking back along the bare corridor it came). 0 and 0 hold as above.
+  // walking back along the bare corridor it came). 0 and 0 hold as above
+  // (hector/open_direction_hold.hpp).
   double degeneracy_hold_after_s = 0.0;
   double degeneracy_hold_max_s = 0.0;
   // On a scanner's stream, points where the map (level 1) holds only cells below this occupancy

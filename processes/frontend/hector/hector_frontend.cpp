@@ -34,7 +34,8 @@ HectorFrontend::HectorFrontend(const FrontendConfig& config)
       scan_points_(config.T_base_laser.pose(), config.matcher.min_range_m,
                    config.matcher.max_range_m),
       motion_(T_initial_, R_base_imu(config.deskew), config.motion_prior),
-      map_(config.map) {}
+      map_(config.map),
+      open_hold_(config.matcher) {}
 
 bool HectorFrontend::add_imu(int64_t utime, const Eigen::Vector3d& angular_velocity_imu) {
   return counted(motion_.add_imu(utime, angular_velocity_imu), counters_.imu_samples,
@@ -245,38 +246,18 @@ void HectorFrontend::hold_degenerate(FrontendResult& r, const MatchResult& match
                                      const MotionModel::Prediction& prediction) {
   const Degeneracy dg = degeneracy(match.information, points_matched);
   r.diagnostics->degeneracy_ratio = dg.ratio;
-  note_determined(r.utime, dg.directions == 0);
+  open_hold_.note(r.utime, dg.directions == 0);
   if (config_.matcher.degeneracy_min_ratio <= 0.0 || dg.directions == 0) return;
   ++counters_.scans_degenerate;
   r.diagnostics->degenerate_directions = dg.directions;
   // Odometry measures the motion along such a direction. Without it the velocity of the last
   // poses carries on the speed the corridor was entered with, and the match's faint grip (an end
   // wall 40 m ahead, a door recess) does better than that in a long bare corridor; held there
-  // only on request (MatcherConfig::degeneracy_hold_without_odometry, which the config check lets
-  // through only with that velocity bounded). Either way the covariance says how little the scan
-  // fixed there.
-  if (prediction.odometry || hold_without_odometry(r.utime))
+  // only on request, and where the scans measured that velocity (open_direction_hold.hpp). Either
+  // way the covariance says how little the scan fixed there.
+  if (prediction.odometry || open_hold_.holds(r.utime))
     r.T_map_base = remap(dg, prediction.T_map_base, r.T_map_base);
   r.covariance = remapped_covariance(dg, prediction.covariance);
-}
-
-void HectorFrontend::note_determined(int64_t utime, bool determined) {
-  if (!determined) {
-    determined_run_start_utime_.reset();
-    return;
-  }
-  if (!determined_run_start_utime_) determined_run_start_utime_ = utime;
-  const double run_s = 1e-6 * static_cast<double>(utime - *determined_run_start_utime_);
-  if (run_s >= config_.matcher.degeneracy_hold_after_s) measured_velocity_utime_ = utime;
-}
-
-bool HectorFrontend::hold_without_odometry(int64_t utime) const {
-  const MatcherConfig& c = config_.matcher;
-  if (!c.degeneracy_hold_without_odometry) return false;
-  if (c.degeneracy_hold_after_s <= 0.0 && c.degeneracy_hold_max_s <= 0.0) return true;
-  if (!measured_velocity_utime_) return false;
-  const double since_s = 1e-6 * static_cast<double>(utime - *measured_velocity_utime_);
-  return c.degeneracy_hold_max_s <= 0.0 || since_s <= c.degeneracy_hold_max_s;
 }
 
 bool HectorFrontend::differ(const Pose2& a, const Pose2& b) const {

@@ -33,6 +33,7 @@
 #include "frontend_config.hpp"
 #include "map_pyramid.hpp"
 #include "motion_model.hpp"
+#include "open_direction_hold.hpp"
 #include "scan_matcher.hpp"
 #include "scan_points.hpp"
 #include "two_phase.hpp"
@@ -116,11 +117,6 @@ class HectorFrontend final : public TwoPhaseFrontend {
   void hold_degenerate(FrontendResult& r, const MatchResult& match,
                        const std::vector<Eigen::Vector2d>& points_matched,
                        const MotionModel::Prediction& prediction);
-  // Keeps track of the scans that determined the whole pose (determined: this one did).
-  void note_determined(int64_t utime, bool determined);
-  // Open directions are held at the prediction without odometry at `utime`
-  // (MatcherConfig::degeneracy_hold_without_odometry, _after_s, _max_s).
-  bool hold_without_odometry(int64_t utime) const;
   // a and b lie more than a map cell or 0.01 rad apart (worth matching from both).
   bool differ(const Pose2& a, const Pose2& b) const;
   // a fits better than b: verified where b is not, else a residual lower by more than margin.
@@ -148,11 +144,7 @@ class HectorFrontend final : public TwoPhaseFrontend {
   MapPyramid map_;
   std::optional<Pose2> T_map_base_last_update_;
   std::optional<Integrated> before_tentative_;
-  // The scans that determined the whole pose (MatcherConfig::degeneracy_hold_after_s): [us]
-  // stamp of the first of the current unbroken run (none while a scan leaves a direction open),
-  // and of the last scan that ended a run at least degeneracy_hold_after_s long.
-  std::optional<int64_t> determined_run_start_utime_;
-  std::optional<int64_t> measured_velocity_utime_;
+  OpenDirectionHold open_hold_;
   Counters counters_;
 };
 
