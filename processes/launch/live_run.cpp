@@ -1,7 +1,7 @@
 // The live run: the graph's processes on one LCM bus, each started on its deployment host. The
-// first host's launcher also records every channel (lcm-logger), judges the run (traverse-monitor)
-// and replays the input log standing in for the drivers; another host's launcher only runs its
-// own processes until it is stopped. Deaths are handled by the deployment's policy.
+// first host's launcher also records every channel (traverse-record), judges the run
+// (traverse-monitor) and replays the input log standing in for the drivers; another host's launcher
+// only runs its own processes until it is stopped. Deaths are handled by the deployment's policy.
 #include <unistd.h>
 
 #include <chrono>
@@ -132,15 +132,15 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
   if (plan.records) {
     std::vector<std::string> monitor_argv = plan.monitor_argv;
     monitor_argv.insert(monitor_argv.begin() + 1, {"--lcm-url", o.lcm_url});
-    // LCM_SELF_TEST is udpm's own start-up probe, not part of the run: not recorded; nor are
-    // the channels of --record-without (lcm-logger matches the whole name: ^(...)$).
-    const std::string skipped =
-        "(LCM_SELF_TEST" + (o.record_without.empty() ? "" : "|" + o.record_without) + ")";
+    // The channels of --record-without are not recorded (the recorder matches the whole name;
+    // it leaves out LCM's start-up probe, LCM_SELF_TEST, itself).
+    std::vector<std::string> logger_argv = {
+        plan.logger, "--name", "logger", "--force", url_arg, (out_dir / "run.lcmlog").string()};
+    if (!o.record_without.empty()) {
+      logger_argv.insert(logger_argv.end(), {"--without", o.record_without});
+    }
     spawned =
-        sup.spawn("logger",
-                  {plan.logger, "-f", "-q", "-v", "--channel=" + skipped, url_arg,
-                   (out_dir / "run.lcmlog").string()},
-                  (out_dir / "logger.log").string(), error, plan.host) &&
+        sup.spawn("logger", logger_argv, (out_dir / "logger.log").string(), error, plan.host) &&
         sup.spawn("monitor", monitor_argv, (out_dir / "monitor.log").string(), error, plan.host);
     waiting.insert("monitor");
   }
@@ -225,6 +225,9 @@ int run_live(Options& o, const Plan& plan, const fs::path& out_dir) {
   report.duration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (plan.records && !stop_requested()) {
     for (auto& p : monitor_problems((out_dir / "monitor.json").string())) {
+      report.verdict_problems.push_back(std::move(p));
+    }
+    for (auto& p : recorder_problems((out_dir / "logger.log").string())) {
       report.verdict_problems.push_back(std::move(p));
     }
   }

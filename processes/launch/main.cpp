@@ -1,6 +1,6 @@
 // traverse-launch (called by scripts/run-graph.sh): runs one instance of the process graph on a
 // private LCM URL (or the deployment's, for a graph on several machines: each process on its
-// host, live_run.cpp). Starts lcm-logger (OUTDIR/run.lcmlog), traverse-monitor
+// host, live_run.cpp). Starts traverse-record (OUTDIR/run.lcmlog), traverse-monitor
 // (OUTDIR/monitor.json) and the deployment's processes, waits until each has published its first
 // status, replays the input log with lcm-logplayer, and when playback ends (or on SIGINT/SIGTERM)
 // stops the processes, then the monitor, then the logger. The summary (also OUTDIR/run-graph.json)
@@ -164,11 +164,11 @@ int main(int argc, char** argv) {
   }
 
   // Resolve every program and config before starting anything.
-  plan.logger = find_on_path("lcm-logger");
+  plan.logger = find_program("traverse-record", o.bin_dir);
   plan.player = find_on_path("lcm-logplayer");
   const std::string monitor = find_program("traverse-monitor", o.bin_dir);
   const std::vector<std::pair<std::string, std::string>> tools = {
-      {"lcm-logger", plan.logger},
+      {"traverse-record (in " + o.bin_dir + ")", plan.logger},
       {"lcm-logplayer", plan.player},
       {"traverse-monitor (in " + o.bin_dir + ")", monitor}};
   for (const auto& [what, path] : tools) {

@@ -42,6 +42,30 @@ std::vector<std::string> monitor_problems(const std::string& monitor_json) {
   return out;
 }
 
+std::vector<std::string> recorder_problems(const std::string& recorder_out) {
+  std::ifstream in(recorder_out);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.front() == '{') last = line;
+  }
+  const Json j = Json::parse(last, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("events_written")) {
+    return {"run log: the recorder left no summary in " + recorder_out +
+            " (it did not stop cleanly; the log reads up to its last flush)"};
+  }
+  std::vector<std::string> out;
+  const long dropped = j.value("receive_queue_dropped", 0L);
+  const long failed = j.value("write_errors", 0L);
+  if (dropped > 0) {
+    out.push_back("run log: the recorder's receive queue dropped " + std::to_string(dropped) +
+                  " messages (the log lacks them)");
+  }
+  if (failed > 0) {
+    out.push_back("run log: " + std::to_string(failed) + " events could not be written");
+  }
+  return out;
+}
+
 std::string check_rmem_max(long wanted, bool raise) {
   if (wanted <= 0) return "";
   const char* path = "/proc/sys/net/core/rmem_max";

@@ -36,7 +36,7 @@ struct Plan {
   std::vector<StageSpec> specs;        // the same stages as the deployment gives them
   std::vector<std::string> elsewhere;  // "name (host)" of stages other launchers start
   std::vector<std::string> monitor_argv;
-  std::string logger, player;   // lcm-logger, lcm-logplayer
+  std::string logger, player;   // traverse-record, lcm-logplayer
   std::string host;             // the host this launcher is ("" when the deployment has none)
   bool records = true;          // the first host: logger, monitor and the log's replay
   std::string lcm_url;          // from the deployment, "" for a private one

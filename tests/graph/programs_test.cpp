@@ -22,6 +22,7 @@ const std::set<std::string> kTools = {
 // still be checked, and named when wrong.
 const std::map<std::string, std::string> kRequiredArgs = {
     {"sim", "--world configs/worlds/corridor.yaml --route configs/routes/corridor-return.yaml"},
+    {"record", "/tmp/traverse_programs_test_never_written.lcmlog"},
 };
 
 TEST(Programs, ThereAreSome) {

@@ -66,7 +66,7 @@ TEST(RunGraph, RecordsTheReplayAndEveryStatusOnceASecond) {
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
-// --record-without leaves channels out of run.lcmlog, live (lcm-logger) and offline (the last
+// --record-without leaves channels out of run.lcmlog, live (traverse-record) and offline (the last
 // stage's record copied without them), and nothing else: the graph still hears them.
 TEST(RunGraph, RecordWithoutLeavesTheNamedChannelsOut) {
   const auto dir = temp_dir("record-without");
