@@ -138,4 +138,17 @@ std::optional<LogEvent> LogReader::next() {
   return std::nullopt;
 }
 
+bool LogWriter::write(const std::string& channel, const uint8_t* data, std::size_t size,
+                      int64_t utime) {
+  lcm::LogEvent ev;
+  ev.eventnum = events_;
+  ev.timestamp = utime;
+  ev.channel = channel;
+  ev.datalen = static_cast<int32_t>(size);
+  ev.data = const_cast<uint8_t*>(data);
+  if (file_.writeEvent(&ev) != 0) return false;
+  ++events_;
+  return true;
+}
+
 }  // namespace traverse

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -62,6 +63,23 @@ class LogReader {
   std::FILE* file_ = nullptr;
   uint64_t file_size_ = 0;
   uint64_t pos_ = 0;
+};
+
+// Writes an LCM log file event by event, numbering the events from 0 (lcm::LogFile writes them):
+// the one writer of the run log's recorder, a process's --record and the offline run's copy.
+class LogWriter {
+ public:
+  explicit LogWriter(const std::string& path) : file_(path, "w") {}
+  bool good() { return file_.good(); }
+  // One event stamped `utime` [us]; false if it could not be written.
+  bool write(const std::string& channel, const uint8_t* data, std::size_t size, int64_t utime);
+  // Hands what was written to the operating system; false if that failed.
+  bool flush() { return std::fflush(file_.getFilePtr()) == 0; }
+  int64_t events() const { return events_; }
+
+ private:
+  lcm::LogFile file_;
+  int64_t events_ = 0;
 };
 
 }  // namespace traverse

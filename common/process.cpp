@@ -110,18 +110,11 @@ void Process::offer_replay() {
 // Writes every message of the in-process bus to the --record log, stamped with the time of the
 // input event being handled.
 struct Process::Recorder {
-  std::unique_ptr<lcm::LogFile> log;
+  std::unique_ptr<LogWriter> log;
   int64_t utime = 0;  // [us] time of the input event being handled
-  int64_t events = 0;
 
   void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    lcm::LogEvent ev;
-    ev.eventnum = events++;
-    ev.timestamp = utime;
-    ev.channel = channel;
-    ev.datalen = static_cast<int32_t>(rbuf->data_size);
-    ev.data = rbuf->data;
-    log->writeEvent(&ev);
+    log->write(channel, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size, utime);
   }
 };
 
@@ -167,7 +160,7 @@ std::optional<int> Process::connect() {
                                        });
   if (!record_path_.empty()) {
     recorder_ = std::make_unique<Recorder>();
-    recorder_->log = std::make_unique<lcm::LogFile>(record_path_, "w");
+    recorder_->log = std::make_unique<LogWriter>(record_path_);
     if (!recorder_->log->good()) {
       spdlog::error("traverse-{}: cannot write --record {}", name_, record_path_);
       return 1;

@@ -20,19 +20,12 @@ namespace {
 // The intact events of `in` whose channel does not match `skip` (the whole name), renumbered.
 bool copy_log_without(const fs::path& in, const fs::path& out, const std::string& skip) {
   const std::regex skipped(skip);
-  lcm::LogFile log(out.string(), "w");
+  LogWriter log(out.string());
   if (!log.good()) return false;
   LogReader reader(in.string());
-  int64_t number = 0;
   while (auto ev = reader.next()) {
     if (std::regex_match(ev->channel, skipped)) continue;
-    lcm::LogEvent e;
-    e.eventnum = number++;
-    e.timestamp = ev->utime;
-    e.channel = ev->channel;
-    e.datalen = static_cast<int32_t>(ev->data.size());
-    e.data = ev->data.data();
-    if (log.writeEvent(&e) != 0) return false;
+    if (!log.write(ev->channel, ev->data.data(), ev->data.size(), ev->utime)) return false;
   }
   return true;
 }

@@ -14,7 +14,7 @@ Recorder::Recorder(Bus& bus, const std::string& path, const std::string& without
     }
     has_without_ = true;
   }
-  log_ = std::make_unique<lcm::LogFile>(path, "w");
+  log_ = std::make_unique<LogWriter>(path);
   if (!log_->good()) throw std::runtime_error("cannot write " + path);
   handle_ = bus_.subscribe_raw(
       ".*", [this](const std::string& channel, const uint8_t* data, int size, int64_t recv_utime) {
@@ -42,22 +42,15 @@ void Recorder::on_message(const std::string& channel, const uint8_t* data, int s
     ++skipped_;
     return;
   }
-  lcm::LogEvent ev;
-  ev.eventnum = events_;
-  ev.timestamp = recv_utime;
-  ev.channel = channel;
-  ev.datalen = size;
-  ev.data = const_cast<uint8_t*>(data);
-  if (log_->writeEvent(&ev) != 0) {
+  if (!log_->write(channel, data, static_cast<std::size_t>(size), recv_utime)) {
     ++write_errors_;
     return;
   }
-  ++events_;
   bytes_ += size;
 }
 
 void Recorder::flush() {
-  if (log_ && std::fflush(log_->getFilePtr()) != 0) ++write_errors_;
+  if (log_ && !log_->flush()) ++write_errors_;
 }
 
 }  // namespace traverse::record

@@ -9,13 +9,13 @@
 #pragma once
 
 #include <cstdint>
-#include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <regex>
 #include <string>
 #include <unordered_map>
 
 #include "bus.hpp"
+#include "lcm_log.hpp"
 
 namespace traverse::record {
 
@@ -41,7 +41,7 @@ class Recorder {
   // that reads up to here.
   void flush();
 
-  int64_t events() const { return events_; }    // written
+  int64_t events() const { return log_->events(); }  // written
   int64_t bytes() const { return bytes_; }      // of message data written
   int64_t skipped() const { return skipped_; }  // left out by --without
   int64_t write_errors() const { return write_errors_; }
@@ -52,11 +52,11 @@ class Recorder {
 
   Bus& bus_;
   Bus::Handle handle_ = nullptr;
-  std::unique_ptr<lcm::LogFile> log_;
+  std::unique_ptr<LogWriter> log_;
   std::regex without_;
   bool has_without_ = false;
   std::unordered_map<std::string, bool> wanted_;  // by channel, decided once
-  int64_t events_ = 0, bytes_ = 0, skipped_ = 0, write_errors_ = 0;
+  int64_t bytes_ = 0, skipped_ = 0, write_errors_ = 0;
 };
 
 }  // namespace traverse::record
